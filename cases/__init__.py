@@ -1,0 +1,1 @@
+"""Case scripts: ``python -m cases.NAME --preset quick|paper``."""

@@ -1,0 +1,1 @@
+"""Particle–block and block–block point–edge contacts (planned)."""

@@ -1,0 +1,11 @@
+"""Physical laws: DEM contact laws and rolling resistance.
+
+One law per file; each file holds the user-facing parameter class and the Taichi
+function the engine calls for one contact.
+"""
+from .contact_law import ContactLaw
+from .linear import LinearContact
+from .hertz_mindlin import HertzMindlin
+from .rolling import RollingResistance
+
+__all__ = ["ContactLaw", "LinearContact", "HertzMindlin", "RollingResistance"]

@@ -1,0 +1,165 @@
+"""The contact-law table shared by all laws, and the dispatch for one contact.
+
+Every law is packed into one row of floats so that the engine's kernels can read
+any law from one array. Columns:
+
+====  ==========================================================
+0     law type: 0 linear (Cundall & Strack), 1 Hertz–Mindlin
+1     k_n (linear) or E* (Hertz)
+2     k_s (linear) or G* (Hertz)
+3     friction coefficient tan(phi_mu)
+4     cohesion c (force, N) in the Coulomb limit
+5     beta: contact damping c_n = beta k_n, c_s = beta k_s (C&S Eq. 28)
+6     gamma_e = 2 ln(1/e)/sqrt(pi^2 + ln^2 e): c_n = gamma_e sqrt(k_n m*)
+7     rolling resistance delta (B = delta r_bar), 0 = off
+8     rolling model (1 elastic-perfectly plastic, 2 elastic-brittle)
+9     rolling damping on (1) or off (0)
+====  ==========================================================
+"""
+import math
+
+import taichi as ti
+
+from .validate import non_negative
+
+LAW_WIDTH = 12
+LINEAR, HERTZ = 0, 1
+
+
+class ContactLaw:
+    """Base class of particle–particle and particle–wall contact laws."""
+
+    rolling = None
+
+    def row(self):
+        raise NotImplementedError
+
+    def critical_stiffness(self, radius, mass):
+        """Largest stiffness the law reaches for a particle of this radius (for Δt)."""
+        raise NotImplementedError
+
+    @staticmethod
+    def _gamma_from_restitution(restitution):
+        if restitution is None:
+            return 0.0
+        e = float(restitution)
+        if not (0.0 < e <= 1.0) or math.isnan(e):
+            raise ValueError  # replaced by the caller's message
+        if e == 1.0:
+            return 0.0
+        le = math.log(1.0 / e)
+        return 2.0 * le / math.sqrt(math.pi ** 2 + le ** 2)
+
+    def _rolling_columns(self):
+        r = self.rolling
+        if r is None:
+            return [0.0, 0.0, 0.0]
+        return [r.delta, float(r.model), 1.0 if r.damping else 0.0]
+
+    def to_dict(self):
+        d = {k: v for k, v in self.__dict__.items() if not k.startswith("_") and k != "rolling"}
+        d["type"] = type(self).__name__
+        if self.rolling is not None:
+            d["rolling"] = self.rolling.to_dict()
+        return d
+
+    @staticmethod
+    def from_dict(d):
+        from .hertz_mindlin import HertzMindlin
+        from .linear import LinearContact
+        from .rolling import RollingResistance
+        d = dict(d)
+        cls = {"LinearContact": LinearContact, "HertzMindlin": HertzMindlin}[d.pop("type")]
+        if "rolling" in d:
+            d["rolling"] = RollingResistance(**d["rolling"])
+        return cls(**d)
+
+    def __repr__(self):
+        args = ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items() if k != "type")
+        return f"{type(self).__name__}({args})"
+
+
+def check_friction_cohesion(friction, cohesion, damping_ratio):
+    return (non_negative("friction", friction), non_negative("cohesion", cohesion),
+            non_negative("damping_ratio", damping_ratio))
+
+
+@ti.func
+def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt):
+    """Coulomb limit |F_s| <= F_n tan(phi) + c (C&S Eq. 19), keeping the sign.
+
+    Returns (spring force kept, total shear force, dissipated energy). The shear
+    dashpot is off while sliding (C&S).
+    """
+    fmax = ti.max(fn_el * mu + coh, 0.0)
+    fs = fs_trial
+    fs_tot = 0.0
+    diss = 0.0
+    if ti.abs(fs_trial) > fmax:
+        fs = ti.math.sign(fs_trial) * fmax
+        fs_tot = fs
+        if ks > 0.0:
+            diss = fmax * ti.abs(fs_trial - fs) / ks
+    else:
+        fs_tot = fs + cs * vs
+        diss = cs * vs * vs * dt
+    return fs, fs_tot, diss
+
+
+@ti.func
+def pair_force(lawp: ti.template(), L, u, vn, vs, meff, reff, dt, fs_old):
+    """Forces of one contact in its local frame (n from i to j, t = n rotated +90°).
+
+    u: overlap (> 0), vn, vs: relative velocity of j w.r.t. i along n and t,
+    meff: m* (m_i for a wall), reff: R* = R_i R_j/(R_i+R_j) (R_i for a wall).
+    Returns (F_n elastic, F_n total, F_s spring, F_s total, tangent k_n, c_n, dissipation),
+    F_n compression-positive.
+    """
+    kind = ti.cast(lawp[L, 0], ti.i32)
+    fn_el = 0.0
+    kn = 0.0
+    ks = 0.0
+    if kind == LINEAR:
+        kn = lawp[L, 1]
+        ks = lawp[L, 2]
+        fn_el = kn * u
+    else:
+        # Hertz (Miyata Eqs. 24, 27, 31): a = sqrt(R* u)
+        a = ti.sqrt(reff * u)
+        fn_el = 4.0 / 3.0 * lawp[L, 1] * a * u
+        kn = 2.0 * lawp[L, 1] * a
+        ks = 8.0 * lawp[L, 2] * a
+    beta = lawp[L, 5]
+    cn = beta * kn + lawp[L, 6] * ti.sqrt(kn * meff)
+    cs = beta * ks
+    fn = fn_el - cn * vn
+    fs, fs_tot, diss = coulomb_shear(fs_old + ks * vs * dt, fn_el, lawp[L, 3], lawp[L, 4],
+                                     ks, cs, vs, dt)
+    diss += cn * vn * vn * dt
+    return fn_el, fn, fs, fs_tot, kn, cn, diss
+
+
+@ti.func
+def elastic_energy(lawp: ti.template(), L, u, reff, fs, moment, rbar):
+    """Energy stored in the springs of one contact (normal, shear, rolling)."""
+    kind = ti.cast(lawp[L, 0], ti.i32)
+    e = 0.0
+    kn = 0.0
+    ks = 0.0
+    if kind == LINEAR:
+        kn = lawp[L, 1]
+        ks = lawp[L, 2]
+        e = 0.5 * kn * u * u
+    else:
+        a = ti.sqrt(reff * u)
+        kn = 2.0 * lawp[L, 1] * a
+        ks = 8.0 * lawp[L, 2] * a
+        e = 0.4 * (4.0 / 3.0 * lawp[L, 1] * a * u) * u
+    if ks > 0.0:
+        e += 0.5 * fs * fs / ks
+    delta = lawp[L, 7]
+    if delta > 0.0 and kn > 0.0:
+        b = delta * rbar
+        km = kn * b * b / 12.0
+        e += 0.5 * moment * moment / km
+    return e

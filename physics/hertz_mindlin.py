@@ -1,0 +1,53 @@
+"""Hertz–Mindlin contact (Miyata et al. 2002, Eqs. 24–31).
+
+Normal force N = (4/3) E* sqrt(R*) u_n^(3/2) (Eq. 24) with tangent stiffness
+k_n = 2 E* sqrt(R* u_n) (Eq. 27); tangential stiffness k_s = 8 G* a with
+a = (3 N R*/(4 E*))^(1/3) = sqrt(R* u_n), the "linear pressure-dependent" model of
+Eq. 31, used incrementally as in the linear law, with the Coulomb limit.
+
+Two bodies of the same material: 1/E* = 2(1 − ν²)/E, 1/G* = 2(2 − ν)/G with
+G = E/(2(1 + ν)); R* = R_i R_j/(R_i + R_j) (R_i against a wall). Miyata's Eq. 26
+prints R* = 2R_iR_j/(R_i+R_j) and Eq. 25 (1 − ν)²: we use the standard Hertz
+forms, which go with the 4/3 prefactor. The sphere formula is used for discs, as
+2D DEM codes commonly do. A restitution coefficient sets a normal dashpot with
+Miyata Eq. 17 evaluated with the current tangent stiffness.
+"""
+from tdem.errors import InputError
+
+from .contact_law import HERTZ, ContactLaw, check_friction_cohesion
+from .validate import in_range, positive
+
+
+class HertzMindlin(ContactLaw):
+    """Non-linear Hertz normal contact with Mindlin tangential stiffness."""
+
+    def __init__(self, young, poisson, friction=0.5, restitution=None, cohesion=0.0,
+                 damping_ratio=0.0, rolling=None):
+        self.young = positive("young", young)
+        self.poisson = in_range("poisson", poisson, -1.0, 0.5, lo_open=True, hi_open=True)
+        self.friction, self.cohesion, self.damping_ratio = check_friction_cohesion(
+            friction, cohesion, damping_ratio)
+        try:
+            self._gamma = self._gamma_from_restitution(restitution)
+        except (ValueError, TypeError):
+            raise InputError(f"restitution must lie in (0, 1], got {restitution!r}") from None
+        self.restitution = None if restitution is None else float(restitution)
+        self.rolling = rolling
+
+    @property
+    def e_star(self):
+        return self.young / (2.0 * (1.0 - self.poisson ** 2))
+
+    @property
+    def g_star(self):
+        g = self.young / (2.0 * (1.0 + self.poisson))
+        return g / (2.0 * (2.0 - self.poisson))
+
+    def row(self):
+        return [float(HERTZ), self.e_star, self.g_star, self.friction, self.cohesion,
+                self.damping_ratio, self._gamma] + self._rolling_columns() + [0.0, 0.0]
+
+    def critical_stiffness(self, radius, mass):
+        """Tangent stiffness at an overlap of 5 % of the radius (a conservative bound)."""
+        a = (radius * 0.5 * 0.05 * radius) ** 0.5
+        return max(2.0 * self.e_star * a, 8.0 * self.g_star * a)

@@ -1,0 +1,64 @@
+"""Linear spring contact of Cundall & Strack (1979).
+
+Normal: F_n = k_n u_n (total form) plus a dashpot. Shear: incremental,
+F_s <- F_s + k_s v_s Δt (C&S Eqs. 15–18), capped by the Coulomb limit
+|F_s| <= F_n tan(phi_mu) + c (Eq. 19) with F_n the elastic normal force.
+Damping: c_n = beta k_n, c_s = beta k_s (C&S Eq. 28; the shear dashpot is off
+while sliding), or a normal dashpot from a coefficient of restitution e
+(Miyata Eq. 17): c_n = 2 ln(1/e) sqrt(k_n m* / (pi^2 + ln^2 e)).
+
+The contact lasts while the overlap is positive; the normal force is not clipped
+at zero, so that a restitution-based dashpot gives exactly the restitution e of
+Eq. 17. The kernel side is in :func:`physics.contact_law.pair_force`.
+"""
+from tdem.errors import InputError
+
+from .contact_law import LINEAR, ContactLaw, check_friction_cohesion
+from .validate import positive
+
+
+class LinearContact(ContactLaw):
+    """Linear spring–dashpot contact with Coulomb friction.
+
+    Parameters
+    ----------
+    kn, ks : float
+        Normal and shear stiffness (N/m, per metre of thickness in 2D). ks may be 0.
+    friction : float
+        Friction coefficient tan(phi_mu) (not an angle).
+    cohesion : float
+        Cohesion c of the Coulomb limit, a force (N).
+    restitution : float or None
+        Coefficient of restitution e in (0, 1]: sets the normal dashpot (Miyata Eq. 17).
+    damping_ratio : float
+        beta of C&S contact damping (c = beta k). Combines with ``restitution``.
+    rolling : RollingResistance or None
+        Rolling resistance of Jiang et al. (2005).
+    """
+
+    def __init__(self, kn, ks=None, friction=0.5, cohesion=0.0, restitution=None,
+                 damping_ratio=0.0, rolling=None):
+        self.kn = positive("kn", kn)
+        if ks is None:
+            ks = kn
+        try:
+            self.ks = float(ks)
+        except (TypeError, ValueError):
+            raise InputError(f"ks must be a number >= 0, got {ks!r}") from None
+        if not self.ks >= 0.0 or self.ks == float("inf"):
+            raise InputError(f"ks must be a number >= 0, got {ks!r}")
+        self.friction, self.cohesion, self.damping_ratio = check_friction_cohesion(
+            friction, cohesion, damping_ratio)
+        try:
+            self._gamma = self._gamma_from_restitution(restitution)
+        except (ValueError, TypeError):
+            raise InputError(f"restitution must lie in (0, 1], got {restitution!r}") from None
+        self.restitution = None if restitution is None else float(restitution)
+        self.rolling = rolling
+
+    def row(self):
+        return [float(LINEAR), self.kn, self.ks, self.friction, self.cohesion,
+                self.damping_ratio, self._gamma] + self._rolling_columns() + [0.0, 0.0]
+
+    def critical_stiffness(self, radius, mass):
+        return max(self.kn, self.ks)

@@ -1,0 +1,15 @@
+"""tdem: continuum–discontinuum simulation in geomechanics, on Taichi.
+
+The public API (see README): :class:`Simulation`, the contact laws
+:class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance`, and
+the errors :class:`InputError`, :class:`InstabilityError`.
+"""
+from physics import HertzMindlin, LinearContact, RollingResistance
+
+from .errors import CapacityError, InputError, InstabilityError
+from .simulation import ParticleGroup, Simulation, Wall
+
+__version__ = "0.1.0"
+
+__all__ = ["Simulation", "ParticleGroup", "Wall", "LinearContact", "HertzMindlin",
+           "RollingResistance", "InputError", "InstabilityError", "CapacityError"]

@@ -1,0 +1,188 @@
+"""Cell-grid neighbour search with a Verlet skin.
+
+Particles are binned by a counting sort into square cells of side h >= the largest
+pair cut-off (R_i + R_j + skin). Each particle keeps a *half* list (partners
+j > i, sorted by j) in fixed-capacity slots, and a *reverse* list of the slots of
+other particles that name it, so that pair forces are computed once per pair and
+gathered without atomics, in a fixed order (results do not depend on the number
+of threads).
+
+Contact history (shear spring, rolling couple) lives in the half-list slots and is
+carried over from the previous list whenever the pair is still listed.
+
+The lists are rebuilt only when some particle has moved more than half the skin
+since the last build; the integrator raises a flag on the device. On the GPU the
+rebuild kernel is launched every step and does nothing unless the flag is up; on
+the CPU the host reads the flag (shared memory, no transfer).
+
+Out-of-grid particles are clamped to the border cells: this keeps the search
+exact (clamping never separates two cells by more than one), only slower, until
+the host refits the grid at its next check.
+
+Overflow of the slots is counted (flags[F_NEED]) and never written past; the
+simulation grows the arrays and redoes the steps since its last check.
+"""
+import taichi as ti
+
+# indices in the int status array ``flags``
+F_REBUILD = 0    # 1: lists must be rebuilt before the next force computation
+F_NEED = 1       # largest number of slots any particle needed (half or reverse list)
+F_WALL_NEED = 2  # largest number of wall slots any particle needed
+F_BAD = 3        # smallest index of an unstable particle (n if none)
+F_BUILDS = 4     # number of list builds so far
+FLAGS_SIZE = 8
+
+
+@ti.func
+def cell_of(x, gridp: ti.template(), nx: ti.i32, ny: ti.i32):
+    cx = ti.cast(ti.floor((x[0] - gridp[0]) / gridp[2]), ti.i32)
+    cy = ti.cast(ti.floor((x[1] - gridp[1]) / gridp[2]), ti.i32)
+    return ti.math.clamp(cx, 0, nx - 1), ti.math.clamp(cy, 0, ny - 1)
+
+
+@ti.kernel
+def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.ndarray(),
+            nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
+            nbr_old: ti.types.ndarray(), ncnt_old: ti.types.ndarray(),
+            hist_old: ti.types.ndarray(), rev: ti.types.ndarray(), rcnt: ti.types.ndarray(),
+            cell_count: ti.types.ndarray(), cell_start: ti.types.ndarray(),
+            sorted_ids: ti.types.ndarray(), pcell: ti.types.ndarray(),
+            gridp: ti.types.ndarray(), gridn: ti.types.ndarray(), flags: ti.types.ndarray(),
+            skin: ti.f64):
+    n = pos.shape[0]
+    cap = nbr.shape[1]
+    nx = gridn[0]
+    ny = gridn[1]
+    ncell = nx * ny
+    # 1. keep the old lists (for the history), clear the cell counts
+    for i in range(n):
+        if flags[F_REBUILD] != 0:
+            ncnt_old[i] = ncnt[i]
+            for k in range(cap):
+                nbr_old[i, k] = nbr[i, k]
+                hist_old[i, k] = hist[i, k]
+    for c in range(ncell):
+        if flags[F_REBUILD] != 0:
+            cell_count[c] = 0
+    # 2. count particles per cell
+    for i in range(n):
+        if flags[F_REBUILD] != 0:
+            cx, cy = cell_of(pos[i], gridp, nx, ny)
+            c = cy * nx + cx
+            pcell[i] = c
+            ti.atomic_add(cell_count[c], 1)
+    # 3. exclusive prefix sum: rows in parallel, then row offsets serially
+    for r in range(ny):
+        if flags[F_REBUILD] != 0:
+            s = 0
+            for cx in range(nx):
+                c = r * nx + cx
+                cell_start[c] = s
+                s += cell_count[c]
+            cell_start[ncell + r] = s  # row totals stored past the cells
+    ti.loop_config(serialize=True)
+    for r in range(ny):
+        if flags[F_REBUILD] != 0:
+            if r == 0:
+                gridn[3] = 0
+            tot = cell_start[ncell + r]
+            cell_start[ncell + r] = gridn[3]
+            gridn[3] += tot
+    for c in range(ncell):
+        if flags[F_REBUILD] != 0:
+            cell_start[c] += cell_start[ncell + c // nx]
+            cell_count[c] = 0
+    # 4. scatter particles into cell order
+    for i in range(n):
+        if flags[F_REBUILD] != 0:
+            c = pcell[i]
+            slot = ti.atomic_add(cell_count[c], 1)
+            sorted_ids[cell_start[c] + slot] = i
+    # 5. half lists, sorted by partner index, with the history carried over
+    for i in range(n):
+        if flags[F_REBUILD] != 0:
+            xi = pos[i]
+            ri = prop[i][0]
+            cx, cy = cell_of(xi, gridp, nx, ny)
+            cnt = 0
+            back = 0
+            for dy in ti.static(range(-1, 2)):
+                for dx in ti.static(range(-1, 2)):
+                    ccx = cx + dx
+                    ccy = cy + dy
+                    if 0 <= ccx < nx and 0 <= ccy < ny:
+                        c = ccy * nx + ccx
+                        for s in range(cell_start[c], cell_start[c] + cell_count[c]):
+                            j = sorted_ids[s]
+                            if j != i:
+                                d = pos[j] - xi
+                                cut = ri + prop[j][0] + skin
+                                if d.dot(d) < cut * cut:
+                                    if j > i:
+                                        if cnt < cap:
+                                            # insertion into the sorted list
+                                            k = cnt
+                                            while k > 0 and nbr[i, k - 1] > j:
+                                                nbr[i, k] = nbr[i, k - 1]
+                                                k -= 1
+                                            nbr[i, k] = j
+                                        cnt += 1
+                                    else:
+                                        back += 1
+            ti.atomic_max(flags[F_NEED], ti.max(cnt, back))
+            m = ti.min(cnt, cap)
+            ncnt[i] = m
+            for k in range(m):
+                j = nbr[i, k]
+                h = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                for kk in range(ncnt_old[i]):
+                    if nbr_old[i, kk] == j:
+                        h = hist_old[i, kk]
+                hist[i, k] = h
+            for k in range(m, cap):
+                nbr[i, k] = -1
+                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            xref[i] = xi
+            rcnt[i] = 0
+    # 6. reverse lists (who names me), then sorted for a fixed summation order
+    for j in range(n):
+        if flags[F_REBUILD] != 0:
+            for k in range(ncnt[j]):
+                i = nbr[j, k]
+                r = ti.atomic_add(rcnt[i], 1)
+                if r < cap:
+                    rev[i, r] = j * cap + k
+    for i in range(n):
+        if flags[F_REBUILD] != 0:
+            m = ti.min(rcnt[i], cap)
+            rcnt[i] = m
+            for a in range(1, m):
+                v = rev[i, a]
+                b = a
+                while b > 0 and rev[i, b - 1] > v:
+                    rev[i, b] = rev[i, b - 1]
+                    b -= 1
+                rev[i, b] = v
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        if flags[F_REBUILD] != 0:
+            flags[F_BUILDS] += 1
+            flags[F_REBUILD] = 0
+
+
+@ti.kernel
+def bounds(pos: ti.types.ndarray(), prop: ti.types.ndarray(), out: ti.types.ndarray()):
+    """out = (xmin, ymin, xmax, ymax, rmax) over finite positions."""
+    out[0] = 1e300
+    out[1] = 1e300
+    out[2] = -1e300
+    out[3] = -1e300
+    out[4] = 0.0
+    for i in range(pos.shape[0]):
+        x = pos[i]
+        if ti.abs(x[0]) < 1e200 and ti.abs(x[1]) < 1e200:
+            ti.atomic_min(out[0], x[0])
+            ti.atomic_min(out[1], x[1])
+            ti.atomic_max(out[2], x[0])
+            ti.atomic_max(out[3], x[1])
+        ti.atomic_max(out[4], prop[i][0])

@@ -1,0 +1,983 @@
+"""The simulation object: Python orchestrates, kernels compute.
+
+State lives in ``ti.ndarray`` objects (structure of arrays; fixed-capacity contact
+slots per particle). One time step is :func:`tdem.step.step` (forces, gather,
+integration, walls) preceded, when the skin check asks for it, by
+:func:`tdem.neighbors.rebuild`. The host only looks at the device every
+``check_interval`` steps: it then reads the status word (slot overflow, unstable
+particles), keeps a device-side snapshot of the state, records monitors and writes
+output. A slot overflow restores the snapshot, grows the arrays and redoes the
+steps; an instability restores the snapshot, replays step by step to name the
+step and the particle, keeps the last good state and raises
+:class:`tdem.InstabilityError`.
+"""
+import math
+import signal
+import sys
+import time as _time
+
+import numpy as np
+import taichi as ti
+
+from physics.contact_law import LAW_WIDTH, ContactLaw
+
+from . import backend, neighbors
+from . import snapshot
+from . import step as stepk
+from .errors import CapacityError, InputError, InstabilityError
+from .neighbors import F_BAD, F_BUILDS, F_NEED, F_REBUILD, F_WALL_NEED, FLAGS_SIZE
+
+MAX_SLOTS = 1024
+
+# name: (components, per-slot?, dtype kind). components 0 = scalar.
+_PARTICLE = {
+    "pos": 2, "vel": 2, "omega": 0, "prop": 3, "plaw": "i", "fix": "i", "vfix": 3,
+    "force": 2, "torque": 0, "xref": 2, "pen": 4, "pos0": 2,
+}
+_SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 4, "cs": 3, "rev": "i",
+          "nbr_old": "i", "hist_old": 4}
+_COUNTS = ("ncnt", "rcnt", "ncnt_old")
+_WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3}
+# arrays rebuilt from scratch whenever needed (never saved or restored)
+_SCRATCH = ("cell_count", "cell_start", "sorted", "pcell", "bounds", "nbr_old", "hist_old",
+            "ncnt_old", "simp", "lawp", "lawpair")
+
+
+def _as_xy(name, value, n=None):
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers, got {value!r}") from None
+    if n is not None and a.shape == (2,):
+        a = np.broadcast_to(a, (n, 2)).copy()
+    if a.ndim != 2 or a.shape[1] != 2 or (n is not None and a.shape[0] != n):
+        want = f"({n}, 2)" if n is not None else "(N, 2)"
+        raise InputError(f"{name} must have shape {want} or (2,), got shape {a.shape}")
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(f"{name} must be finite: row {k} is {a[k].tolist()}")
+    return a
+
+
+class ParticleGroup:
+    """Particles added by one call of :meth:`Simulation.add_particles`."""
+
+    def __init__(self, sim, ids, contact, density):
+        self._sim = sim
+        self.ids = ids
+        self.contact = contact
+        self.density = density
+
+    def __len__(self):
+        return len(self.ids)
+
+    def __repr__(self):
+        return f"ParticleGroup({len(self.ids)} particles, ids {self.ids[0]}..{self.ids[-1]})"
+
+
+class Wall:
+    """A rigid segment. ``velocity`` and ``angular_velocity`` may be changed between runs."""
+
+    def __init__(self, sim, index):
+        self._sim = sim
+        self.index = index
+
+    def _row(self):
+        return self._sim._wall_rows()[self.index]
+
+    def _set(self, cols, values):
+        rows = self._sim._wall_rows()
+        rows[self.index, cols] = values
+        self._sim._set_wall_rows(rows)
+
+    @property
+    def velocity(self):
+        r = self._row()
+        return np.array([r[stepk.W_VX], r[stepk.W_VY]])
+
+    @velocity.setter
+    def velocity(self, v):
+        v = _as_xy("velocity", [v])[0]
+        self._set([stepk.W_VX, stepk.W_VY], v)
+
+    @property
+    def angular_velocity(self):
+        """Angular velocity about :attr:`center`, rad/s, counter-clockwise positive."""
+        return float(self._row()[stepk.W_OMEGA])
+
+    @angular_velocity.setter
+    def angular_velocity(self, w):
+        w = float(w)
+        if not math.isfinite(w):
+            raise InputError(f"angular_velocity must be finite, got {w!r}")
+        self._set([stepk.W_OMEGA], [w])
+
+    @property
+    def center(self):
+        r = self._row()
+        return np.array([r[stepk.W_CX], r[stepk.W_CY]])
+
+    @property
+    def endpoints(self):
+        r = self._row()
+        return np.array([[r[stepk.W_X0], r[stepk.W_Y0]], [r[stepk.W_X1], r[stepk.W_Y1]]])
+
+    @property
+    def force(self):
+        """Total contact force (2,) this wall received in the last step."""
+        return self._sim._wall_loads()[self.index, :2].copy()
+
+    @property
+    def moment(self):
+        """Moment of the contact forces about the wall's centre in the last step."""
+        return float(self._sim._wall_loads()[self.index, 2])
+
+    def __repr__(self):
+        return f"Wall({self.index}, endpoints={self.endpoints.tolist()})"
+
+
+class _View:
+    """``sim.particles`` / ``sim.contacts``: ``.numpy()`` gives a dict of arrays."""
+
+    def __init__(self, fn, count):
+        self._fn = fn
+        self._count = count
+
+    def numpy(self):
+        return self._fn()
+
+    def __len__(self):
+        return self._count()
+
+
+class Simulation:
+    """A 2D DEM simulation (plane, unit thickness, SI units).
+
+    Parameters
+    ----------
+    gravity : (2,) m/s²
+    dt : float or None
+        Time step; None picks ``dt_fraction`` × the critical step 2·sqrt(m/k).
+    dt_fraction : float in (0, 1]
+    arch : "cpu" | "gpu" | None (then ``$TDEM_ARCH``, else "cpu")
+    precision : "f64" | "f32" (storage precision of the float arrays)
+    local_damping : α′ of the local non-viscous damping (0 = off)
+    global_damping : α of C&S mass-proportional damping, 1/s (0 = off)
+    skin : Verlet skin (m); None picks 0.4 × the smallest radius
+    check_interval : steps between host checks (status, monitors, output)
+    progress : None (a bar on a terminal for runs over 2 s), True or False
+    threads : CPU threads (process-wide; None: Taichi's default or ``$TDEM_THREADS``)
+    """
+
+    def __init__(self, gravity=(0.0, -9.81), dt=None, dt_fraction=0.2, arch=None,
+                 precision="f64", local_damping=0.0, global_damping=0.0, skin=None,
+                 check_interval=100, progress=None, threads=None):
+        g = _as_xy("gravity", [gravity])[0]
+        if precision not in ("f64", "f32"):
+            raise InputError(f"precision must be 'f64' or 'f32', got {precision!r}")
+        dt_fraction = float(dt_fraction)
+        if not (0.0 < dt_fraction <= 1.0):
+            raise InputError(f"dt_fraction must lie in (0, 1], got {dt_fraction!r}")
+        for name, v in (("local_damping", local_damping), ("global_damping", global_damping)):
+            if not (float(v) >= 0.0 and math.isfinite(float(v))):
+                raise InputError(f"{name} must be a number >= 0, got {v!r}")
+        if float(local_damping) >= 1.0:
+            raise InputError(f"local_damping must lie in [0, 1), got {local_damping!r}")
+        if skin is not None and not (float(skin) > 0.0 and math.isfinite(float(skin))):
+            raise InputError(f"skin must be a positive number, got {skin!r}")
+        if int(check_interval) < 1:
+            raise InputError(f"check_interval must be >= 1, got {check_interval!r}")
+        self.arch = backend.init(arch, threads)
+        self.gravity = g
+        self.precision = precision
+        self._fdt = ti.f64 if precision == "f64" else ti.f32
+        self.dt_fraction = dt_fraction
+        self.local_damping = float(local_damping)
+        self.global_damping = float(global_damping)
+        self._skin_user = None if skin is None else float(skin)
+        self.check_interval = int(check_interval)
+        self.progress = progress
+        self._dt_user = None
+        # host-side description
+        self._laws = []            # ContactLaw objects, index = law id
+        self._pair_override = {}   # (law a, law b) -> law id
+        self._groups = []
+        self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law")}
+        self._walls_host = []      # rows of the wall table
+        self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
+        self._n = 0
+        self._built = False
+        self._a = {}
+        self._snap = {}
+        self._cap = 8
+        self._capw = 4
+        self._time = 0.0
+        self._steps = 0
+        self._monitors = []
+        self._output = None
+        self._fix_fn = None
+        self._last_good = None
+        self._crit_cache = None
+        self._last_fit = 0
+        self._next_event = 1 << 62
+        if dt is not None:
+            self._dt_user = self._check_dt_value(dt)
+        self.particles = _View(self._particles_numpy, lambda: self._n)
+        self.contacts = _View(self._contacts_numpy, lambda: len(self._contacts_numpy()["pairs"]))
+
+    # ------------------------------------------------------------------ set-up
+    def _law_id(self, law, argname="contact"):
+        if not isinstance(law, ContactLaw):
+            raise InputError(f"{argname} must be a contact law such as tdem.LinearContact(...), "
+                             f"got {law!r}")
+        for k, known in enumerate(self._laws):
+            if known is law:
+                return k
+        self._laws.append(law)
+        return len(self._laws) - 1
+
+    def add_particles(self, positions, radius, density=2500.0, contact=None, material=None,
+                      tolerance=0.0, velocity=None):
+        """Add discs; returns a :class:`ParticleGroup` (``.ids`` their indices)."""
+        if material is not None:
+            raise InputError("material: continuum (PCMM) particles are not available in this "
+                             f"version; got material={material!r}")
+        pos = _as_xy("positions", positions)
+        n = len(pos)
+        if n == 0:
+            raise InputError("positions must hold at least one particle, got none")
+        try:
+            r = np.broadcast_to(np.asarray(radius, dtype=float), (n,)).copy()
+        except ValueError:
+            raise InputError(f"radius must be a number or one per particle ({n}), "
+                             f"got shape {np.shape(radius)}") from None
+        bad = ~(np.isfinite(r) & (r > 0))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise InputError(f"radius must be positive: particle {k} has radius {r[k]!r}")
+        rho = np.broadcast_to(np.asarray(density, dtype=float), (n,)).copy()
+        bad = ~(np.isfinite(rho) & (rho > 0))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise InputError(f"density must be positive: particle {k} has density {rho[k]!r}")
+        if contact is None:
+            raise InputError("contact must be given: a law such as tdem.LinearContact(kn=...)")
+        law = self._law_id(contact)
+        vel = np.zeros((n, 2)) if velocity is None else _as_xy("velocity", velocity, n)
+        state = self._download() if self._built else None
+        ids = np.arange(self._n, self._n + n)
+        self._host["pos"].append(pos)
+        self._host["vel"].append(vel)
+        self._host["radius"].append(r)
+        self._host["density"].append(rho)
+        self._host["law"].append(np.full(n, law))
+        self._n += n
+        g = ParticleGroup(self, ids, contact, rho)
+        self._groups.append(g)
+        if state is not None:
+            self._rebuild_from(state, new_particles=(pos, vel, r, rho, law))
+        return g
+
+    def set_contact(self, group_a, group_b, contact):
+        """Use ``contact`` between particles of two groups (default: the law of the group
+        added later)."""
+        la = self._law_id(group_a.contact, "group_a")
+        lb = self._law_id(group_b.contact, "group_b")
+        law = self._law_id(contact)
+        self._pair_override[(la, lb)] = law
+        self._pair_override[(lb, la)] = law
+        if self._built:
+            self._upload_laws()
+
+    def add_wall(self, p0, p1, contact=None, velocity=(0.0, 0.0), angular_velocity=0.0,
+                 center=None):
+        """Add a rigid segment from p0 to p1; it moves with ``velocity`` and rotates at
+        ``angular_velocity`` (rad/s) about ``center`` (default: its midpoint)."""
+        a, b = _as_xy("p0, p1", [p0, p1])
+        if np.allclose(a, b):
+            raise InputError(f"p1 must differ from p0, got p0={a.tolist()} p1={b.tolist()}")
+        if contact is None:
+            raise InputError("contact must be given: a law such as tdem.LinearContact(kn=...)")
+        v = _as_xy("velocity", [velocity])[0]
+        c = 0.5 * (a + b) if center is None else _as_xy("center", [center])[0]
+        w = float(angular_velocity)
+        if not math.isfinite(w):
+            raise InputError(f"angular_velocity must be finite, got {angular_velocity!r}")
+        law = self._law_id(contact)
+        row = np.array([a[0], a[1], b[0], b[1], v[0], v[1], w, c[0], c[1], law], dtype=float)
+        if self._built:
+            state = self._download()
+            self._walls_host.append(row)
+            self._rebuild_from(state)
+        else:
+            self._walls_host.append(row)
+        return Wall(self, len(self._walls_host) - 1)
+
+    @property
+    def walls(self):
+        return [Wall(self, k) for k in range(len(self._walls_host))]
+
+    def fix_particles(self, ids, vx=0.0, vy=None, omega=None):
+        """Prescribe velocity components of particles ``ids``.
+
+        Each of vx, vy, omega is None (free), a float, an array (one per id) or a
+        function of time returning either.
+        """
+        ids = np.atleast_1d(np.asarray(ids, dtype=np.int64))
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
+            raise InputError(f"ids must be particle indices in [0, {self._n}), got "
+                             f"{ids.tolist()[:8]}")
+        vals = []
+        for name, v in (("vx", vx), ("vy", vy), ("omega", omega)):
+            if v is None or callable(v):
+                vals.append(v)
+                continue
+            a = np.broadcast_to(np.asarray(v, dtype=float), ids.shape).copy() \
+                if np.ndim(v) <= 1 and (np.ndim(v) == 0 or len(v) == len(ids)) else None
+            if a is None or not np.isfinite(a).all():
+                raise InputError(f"{name} must be None, a finite number, {len(ids)} numbers "
+                                 f"or a function of time, got {v!r}")
+            vals.append(a)
+        self._fixes.append((ids, *vals))
+        if self._built:
+            self._apply_fixes(initial=True)
+
+    # ------------------------------------------------------------- properties
+    @property
+    def time(self):
+        return self._time
+
+    @property
+    def steps(self):
+        return self._steps
+
+    @property
+    def dt(self):
+        if self._dt_user is not None:
+            return self._dt_user
+        return self.dt_fraction * self.critical_dt()
+
+    @dt.setter
+    def dt(self, value):
+        if value is None:
+            self._dt_user = None
+            return
+        self._dt_user = self._check_dt_value(value)
+
+    def _check_dt_value(self, value):
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise InputError(f"dt must be a positive number, got {value!r}") from None
+        if not (v > 0 and math.isfinite(v)):
+            raise InputError(f"dt must be a positive number, got {value!r}")
+        if self._n:
+            crit = self.critical_dt()
+            if v > crit:
+                raise InputError(f"dt={v!r} is larger than the critical time step "
+                                 f"{crit:.6g} s (2·sqrt(m/k)); use dt <= {crit:.6g}")
+        return v
+
+    @property
+    def skin(self):
+        if self._skin_user is not None:
+            return self._skin_user
+        r = self._radii()
+        return 0.4 * float(r.min()) if len(r) else 0.0
+
+    def _radii(self):
+        if self._built:
+            return self._a["prop"].to_numpy()[:, 0]
+        return np.concatenate(self._host["radius"]) if self._host["radius"] else np.zeros(0)
+
+    def critical_dt(self):
+        """Smallest 2·sqrt(m/k) over particles and the laws each one can meet (C&S p. 54)."""
+        key = (self._n, len(self._laws), len(self._walls_host), len(self._pair_override))
+        if self._crit_cache is None or self._crit_cache[0] != key:
+            self._crit_cache = (key, self._critical_dt())
+        return self._crit_cache[1]
+
+    def _critical_dt(self):
+        if self._n == 0:
+            raise InputError("the critical time step needs particles: add some first")
+        r = self._radii()
+        if self._built:
+            m = self._a["prop"].to_numpy()[:, 1]
+            plaw = self._a["plaw"].to_numpy()
+        else:
+            rho = np.concatenate(self._host["density"])
+            m = rho * np.pi * r ** 2
+            plaw = np.concatenate(self._host["law"])
+        table = self._law_table()
+        wall_laws = {int(w[stepk.W_LAW]) for w in self._walls_host}
+        crit = np.inf
+        present = np.unique(plaw)
+        for law_id in present:
+            sel = plaw == law_id
+            used = {int(table[law_id, other]) for other in present} | wall_laws
+            k = np.zeros(int(sel.sum()))
+            for u in used:
+                law = self._laws[u]
+                k = np.maximum(k, [law.critical_stiffness(ri, mi)
+                                   for ri, mi in zip(r[sel], m[sel])])
+            crit = min(crit, float(np.min(2.0 * np.sqrt(m[sel] / k))))
+        return crit
+
+    def _law_table(self):
+        nl = max(len(self._laws), 1)
+        t = np.zeros((nl, nl), dtype=np.int32)
+        for a in range(nl):
+            for b in range(nl):
+                t[a, b] = self._pair_override.get((a, b), max(a, b))
+        return t
+
+    # ------------------------------------------------------------ device state
+    def _alloc(self, spec, shape):
+        if spec == "i":
+            return ti.ndarray(ti.i32, shape)
+        if spec == 0:
+            return ti.ndarray(self._fdt, shape)
+        return ti.Vector.ndarray(spec, self._fdt, shape)
+
+    def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
+        a = {}
+        for k, spec in _PARTICLE.items():
+            a[k] = self._alloc(spec, (n,))
+        for k, spec in _SLOTS.items():
+            a[k] = self._alloc(spec, (n, cap))
+        for k in _COUNTS:
+            a[k] = ti.ndarray(ti.i32, (n,))
+        for k, spec in _WSLOTS.items():
+            a[k] = self._alloc(spec, (n, capw))
+        a["wall"] = ti.ndarray(ti.f64, (max(nwalls, 1), stepk.WALL_WIDTH))
+        a["wforce"] = ti.Vector.ndarray(3, ti.f64, (max(nwalls, 1),))
+        a["lawp"] = ti.ndarray(ti.f64, (nlaws, LAW_WIDTH))
+        a["lawpair"] = ti.ndarray(ti.i32, (nlaws, nlaws))
+        a["flags"] = ti.ndarray(ti.i32, (FLAGS_SIZE,))
+        a["simp"] = ti.ndarray(ti.f64, (stepk.SIMP_SIZE,))
+        a["cell_count"] = ti.ndarray(ti.i32, (ncell,))
+        a["cell_start"] = ti.ndarray(ti.i32, (ncell + 4096,))
+        a["sorted"] = ti.ndarray(ti.i32, (n,))
+        a["pcell"] = ti.ndarray(ti.i32, (n,))
+        a["gridp"] = ti.ndarray(ti.f64, (4,))
+        a["gridn"] = ti.ndarray(ti.i32, (4,))
+        a["bounds"] = ti.ndarray(ti.f64, (5,))
+        return a
+
+    def _fresh_state(self):
+        pos = np.concatenate(self._host["pos"])
+        vel = np.concatenate(self._host["vel"])
+        r = np.concatenate(self._host["radius"])
+        rho = np.concatenate(self._host["density"])
+        m = rho * np.pi * r ** 2
+        n = len(r)
+        s = {
+            "pos": pos, "vel": vel, "omega": np.zeros(n), "pos0": pos.copy(),
+            "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
+            "plaw": np.concatenate(self._host["law"]).astype(np.int32),
+            "fix": np.zeros(n, np.int32), "vfix": np.zeros((n, 3)),
+            "force": np.zeros((n, 2)), "torque": np.zeros(n), "xref": pos.copy(),
+            "pen": np.zeros((n, 4)),
+            "nbr": -np.ones((n, self._cap), np.int32), "ncnt": np.zeros(n, np.int32),
+            "hist": np.zeros((n, self._cap, 4)),
+            "wid": -np.ones((n, self._capw), np.int32),
+            "whist": np.zeros((n, self._capw, 4)),
+            "flags": np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32),
+        }
+        return s
+
+    def _build(self):
+        if self._n == 0:
+            raise InputError("the simulation has no particles: call add_particles first")
+        self._rebuild_from(self._fresh_state())
+
+    def _rebuild_from(self, state, new_particles=None):
+        """(Re)allocate every array for the current sizes and fill it from ``state``."""
+        if new_particles is not None:
+            pos, vel, r, rho, law = new_particles
+            m = rho * np.pi * r ** 2
+            n = len(r)
+            add = {"pos": pos, "vel": vel, "omega": np.zeros(n), "pos0": pos.copy(),
+                   "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
+                   "plaw": np.full(n, law, np.int32), "fix": np.zeros(n, np.int32),
+                   "vfix": np.zeros((n, 3)), "force": np.zeros((n, 2)), "torque": np.zeros(n),
+                   "xref": pos.copy(), "pen": np.zeros((n, 4)),
+                   "nbr": -np.ones((n, state["nbr"].shape[1]), np.int32),
+                   "ncnt": np.zeros(n, np.int32),
+                   "hist": np.zeros((n, state["hist"].shape[1], 4)),
+                   "wid": -np.ones((n, state["wid"].shape[1]), np.int32),
+                   "whist": np.zeros((n, state["whist"].shape[1], 4))}
+            for k, v in add.items():
+                state[k] = np.concatenate([state[k], v])
+            state["flags"][F_REBUILD] = 1
+        n = self._n
+        nwalls = len(self._walls_host)
+        ncell = self._grid_cells_for(state["pos"], state["prop"][:, 0])
+        self._a = self._allocate(n, self._cap, self._capw, nwalls, max(len(self._laws), 1), ncell)
+        self._snap = {}
+        for k, v in state.items():
+            if k in self._a:
+                self._fill(k, v)
+        self._built = True
+        self._upload_laws()
+        self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.WALL_WIDTH), fresh=True)
+        self._fit_grid(force=True)
+        self._apply_fixes(initial=True)
+        self._upload_params()
+        self._a["flags"][F_REBUILD] = 1
+
+    def _fill(self, k, v):
+        arr = self._a[k]
+        v = np.asarray(v)
+        want = tuple(arr.shape) + ((arr.n,) if hasattr(arr, "n") else ())
+        if v.shape != want:
+            # pad or cut the slot dimension (growth of capacities)
+            out = np.full(want, -1 if v.dtype.kind == "i" else 0, dtype=v.dtype)
+            sl = tuple(slice(0, min(a, b)) for a, b in zip(want, v.shape))
+            out[sl] = v[sl]
+            v = out
+        arr.from_numpy(v.astype(np.int32 if v.dtype.kind in "iu" else
+                                (np.float64 if arr.dtype == ti.f64 else np.float32)))
+
+    def _download(self):
+        """Every device array as numpy; the host copy of the walls follows the device."""
+        state = {k: v.to_numpy() for k, v in self._a.items() if k not in _SCRATCH}
+        self._walls_host = list(state["wall"][:len(self._walls_host)])
+        return state
+
+    def _upload_laws(self):
+        rows = np.array([law.row() for law in self._laws], dtype=float)
+        self._a["lawp"].from_numpy(rows)
+        self._a["lawpair"].from_numpy(self._law_table())
+
+    def _upload_params(self):
+        p = np.zeros(stepk.SIMP_SIZE)
+        p[stepk.P_DT] = self.dt
+        p[stepk.P_GX], p[stepk.P_GY] = self.gravity
+        p[stepk.P_ALPHA] = self.global_damping
+        p[stepk.P_ALPHA_LOCAL] = self.local_damping
+        p[stepk.P_SKIN] = self.skin
+        p[stepk.P_NWALLS] = len(self._walls_host)
+        self._a["simp"].from_numpy(p)
+        self._dt_run = p[stepk.P_DT]
+
+    def _wall_rows(self):
+        if not self._built:
+            return np.array(self._walls_host, dtype=float).reshape(-1, stepk.WALL_WIDTH)
+        return self._a["wall"].to_numpy()[:len(self._walls_host)]
+
+    def _set_wall_rows(self, rows, fresh=False):
+        if not self._built:
+            self._walls_host = list(rows)
+            return
+        full = np.zeros((max(len(rows), 1), stepk.WALL_WIDTH))
+        full[:len(rows)] = rows
+        self._a["wall"].from_numpy(full)
+        self._walls_host = list(rows)
+
+    def _wall_loads(self):
+        if not self._built:
+            return np.zeros((len(self._walls_host), 3))
+        return self._a["wforce"].to_numpy()[:len(self._walls_host)]
+
+    def _grid_cells_for(self, pos, radius):
+        h = 2.0 * float(radius.max()) + self.skin
+        span = np.ptp(pos, axis=0) + 4 * h
+        nx, ny = (np.ceil(span / h).astype(int) + 1)
+        return int(max(nx * ny, 1))
+
+    def _fit_grid(self, force=False):
+        """Fit the cell grid to the particles' bounding box (host side, at checks)."""
+        a = self._a
+        neighbors.bounds(a["pos"], a["prop"], a["bounds"])
+        b = a["bounds"].to_numpy()
+        lo, hi, rmax = b[:2], b[2:4], b[4]
+        if not np.all(np.isfinite(b)) or hi[0] < lo[0]:
+            return
+        h = 2.0 * rmax + self.skin
+        gp = a["gridp"].to_numpy()
+        gn = a["gridn"].to_numpy()
+        self._last_fit = self._steps
+        if not force:
+            cur_lo = gp[:2]
+            cur_hi = cur_lo + gp[2] * gn[:2]
+            inside = np.all(lo >= cur_lo) and np.all(hi <= cur_hi)
+            if inside and gp[2] >= h and np.prod((hi - lo) / gp[2] + 1) > 0.25 * gn[0] * gn[1]:
+                return
+        margin = 2 * h
+        lo = lo - margin
+        span = (hi + margin) - lo
+        ncap = a["cell_count"].shape[0]
+        limit = max(4 * self._n + 1024, ncap)
+        nx, ny = (np.floor(span / h).astype(np.int64) + 1)
+        while nx * ny > limit:
+            h *= 1.5
+            nx, ny = (np.floor(span / h).astype(np.int64) + 1)
+        if nx * ny > ncap or ny > 4096:
+            self._a["cell_count"] = ti.ndarray(ti.i32, (int(nx * ny),))
+            self._a["cell_start"] = ti.ndarray(ti.i32, (int(nx * ny) + max(int(ny), 4096),))
+        a["gridp"].from_numpy(np.array([lo[0], lo[1], h, 0.0]))
+        a["gridn"].from_numpy(np.array([nx, ny, 0, 0], dtype=np.int32))
+        a["flags"][F_REBUILD] = 1
+        self._last_fit = self._steps
+
+    def _apply_fixes(self, initial=False, t=None):
+        if not self._fixes:
+            return
+        t = self._time if t is None else t
+        if initial:
+            fix = np.zeros(self._n, np.int32)
+            vfix = self._a["vfix"].to_numpy()
+        else:
+            fix = None
+            vfix = self._a["vfix"].to_numpy()
+        any_fn = False
+        for ids, *vals in self._fixes:
+            for bit, col, v in zip((1, 2, 4), range(3), vals):
+                if v is None:
+                    continue
+                if initial:
+                    fix[ids] |= bit
+                if callable(v):
+                    any_fn = True
+                    vfix[ids, col] = np.broadcast_to(np.asarray(v(t), dtype=float), ids.shape)
+                elif initial:
+                    vfix[ids, col] = v
+        if initial:
+            self._a["fix"].from_numpy(fix)
+            self._fix_fn = any_fn
+        self._a["vfix"].from_numpy(vfix.astype(np.float64 if self._fdt == ti.f64 else np.float32))
+
+    # ------------------------------------------------------------------ stepping
+    def _step_args(self):
+        a = self._a
+        return (a["pos"], a["vel"], a["omega"], a["prop"], a["plaw"], a["fix"], a["vfix"],
+                a["force"], a["torque"], a["xref"], a["pen"], a["nbr"], a["ncnt"], a["hist"],
+                a["cn"], a["cf"], a["cs"], a["rev"], a["rcnt"], a["wall"], a["wforce"],
+                a["wid"], a["whist"], a["wcn"], a["wcf"], a["wcs"], a["lawp"], a["lawpair"],
+                a["flags"], a["simp"], backend.serial_loops())
+
+    def _rebuild_args(self):
+        a = self._a
+        return (a["pos"], a["prop"], a["xref"], a["nbr"], a["ncnt"], a["hist"], a["nbr_old"],
+                a["ncnt_old"], a["hist_old"], a["rev"], a["rcnt"], a["cell_count"],
+                a["cell_start"], a["sorted"], a["pcell"], a["gridp"], a["gridn"], a["flags"],
+                float(self.skin))
+
+    def _one_step(self, step_args, rebuild_args, on_cpu):
+        if self._fix_fn:
+            self._apply_fixes(t=self._time)
+        if not on_cpu or self._a["flags"][F_REBUILD] != 0:
+            neighbors.rebuild(*rebuild_args)
+        stepk.step(*step_args)
+        self._time += self._dt_run
+        self._steps += 1
+
+    def _take_snapshot(self):
+        for k in snapshot.ORDER:
+            src = self._a[k]
+            dst = self._snap.get(k)
+            if dst is None or tuple(dst.shape) != tuple(src.shape):
+                self._snap[k] = self._alloc_like(src)
+        snapshot.copy_state(*[self._a[k] for k in snapshot.ORDER],
+                            *[self._snap[k] for k in snapshot.ORDER], backend.serial_loops())
+        self._snap_clock = (self._time, self._steps)
+
+    def _alloc_like(self, src):
+        if hasattr(src, "n"):
+            return ti.Vector.ndarray(src.n, src.dtype, tuple(src.shape))
+        return ti.ndarray(src.dtype, tuple(src.shape))
+
+    def _restore_snapshot(self):
+        snapshot.copy_state(*[self._snap[k] for k in snapshot.ORDER],
+                            *[self._a[k] for k in snapshot.ORDER], backend.serial_loops())
+        self._time, self._steps = self._snap_clock
+        for m in self._monitors:
+            m.truncate(self._steps)
+        if self._output is not None:
+            self._output.truncate(self._steps)
+
+    def _status(self):
+        a = self._a
+        stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["flags"],
+                              float(self._dt_run))
+        return a["flags"].to_numpy()
+
+    def _grow(self, flags):
+        need, needw = int(flags[F_NEED]), int(flags[F_WALL_NEED])
+        state = self._download()
+        if need > self._cap:
+            new = max(need + 2, int(self._cap * 1.5))
+            if new > MAX_SLOTS:
+                raise CapacityError(f"a particle has {need} neighbours within its cut-off; more "
+                                    f"than {MAX_SLOTS} slots are not supported (check radii and "
+                                    "the skin)")
+            self._cap = new
+        if needw > self._capw:
+            self._capw = needw + 1
+        state["flags"][F_NEED] = 0
+        state["flags"][F_WALL_NEED] = 0
+        state["flags"][F_REBUILD] = 1
+        self._rebuild_from(state)
+
+    def run(self, until=None, steps=None):
+        """Advance to simulated time ``until`` or by ``steps`` steps."""
+        if (until is None) == (steps is None):
+            raise InputError(f"give exactly one of until= or steps=, got until={until!r}, "
+                             f"steps={steps!r}")
+        if not self._built:
+            self._build()
+        self._upload_params()
+        dt = self._dt_run
+        if steps is not None:
+            if int(steps) != steps or steps < 0:
+                raise InputError(f"steps must be a whole number >= 0, got {steps!r}")
+            target = self._steps + int(steps)
+        else:
+            until = float(until)
+            if not math.isfinite(until):
+                raise InputError(f"until must be a finite time, got {until!r}")
+            target = self._steps + max(0, int(math.ceil((until - self._time) / dt - 1e-9)))
+        total = target - self._steps
+        self._plan_events()
+        bar = self._progress_bar(total)
+        t_wall = _time.perf_counter()
+        done_at_start = self._steps
+        try:
+            while self._steps < target:
+                self._segment(target, bar)
+                if bar is not None:
+                    bar.update(self._steps - bar.n - done_at_start)
+                    el = _time.perf_counter() - t_wall
+                    bar.set_postfix_str(f"t={self._time:.4g}s, "
+                                        f"{self._n * (self._steps - done_at_start) / max(el, 1e-9):.3g} "
+                                        "particle-steps/s")
+        except KeyboardInterrupt:
+            self._restore_snapshot()
+            self._on_abort("interrupted")
+            raise
+        except InstabilityError:
+            self._on_abort("unstable")
+            raise
+        finally:
+            if bar is not None:
+                bar.close()
+        if self._output is not None:
+            self._output.flush(self)
+        return self
+
+    def _segment(self, target, bar):
+        """Up to ``check_interval`` steps from a snapshot, then one look at the device."""
+        n = min(self.check_interval, target - self._steps)
+        self._take_snapshot()
+        sargs, rargs = self._step_args(), self._rebuild_args()
+        on_cpu = self.arch == "cpu"
+        for _ in range(n):
+            self._one_step(sargs, rargs, on_cpu)
+            if self._steps >= self._next_event:
+                self._events()
+        flags = self._status()
+        if flags[F_NEED] > self._cap or flags[F_WALL_NEED] > self._capw:
+            self._restore_snapshot()
+            self._grow(flags)
+            return
+        if flags[F_BAD] < self._n:
+            self._find_instability()
+        if self._steps - self._last_fit >= self.check_interval:
+            self._fit_grid()
+
+    def _find_instability(self):
+        """Replay the last segment one step at a time to name the failing step."""
+        self._restore_snapshot()
+        sargs, rargs = self._step_args(), self._rebuild_args()
+        on_cpu = self.arch == "cpu"
+        for _ in range(self.check_interval + 1):
+            self._take_snapshot()
+            self._one_step(sargs, rargs, on_cpu)
+            flags = self._status()
+            if flags[F_BAD] < self._n:
+                k = int(flags[F_BAD])
+                step, t = self._steps, self._time
+                s = self._particles_numpy(stress=False)
+                self._restore_snapshot()
+                raise InstabilityError(
+                    f"unstable at step {step} (t = {t:.6g} s): particle {k} has position "
+                    f"{s['position'][k].tolist()} and velocity {s['velocity'][k].tolist()} "
+                    f"(dt = {self._dt_run:.3g} s). The last good state (step {self._steps}) is "
+                    "kept; reduce dt_fraction or check stiffnesses.",
+                    step=step, time=t, particle=k)
+        self._restore_snapshot()
+        raise InstabilityError("unstable run (could not isolate the step)")
+
+    def _events(self):
+        """Record the monitors and write the output that are due now."""
+        for m in self._monitors:
+            if self._steps >= m.next_step:
+                m.record(self)
+        if self._output is not None and self._steps >= self._output.next_step(self):
+            self._output.write(self)
+        self._plan_events()
+
+    def _plan_events(self):
+        nxt = [m.next_step for m in self._monitors]
+        if self._output is not None:
+            nxt.append(self._output.next_step(self))
+        self._next_event = min(nxt) if nxt else 1 << 62
+
+    def _on_abort(self, why):
+        if self._output is not None:
+            self._output.abort(self, why)
+
+    def _progress_bar(self, total):
+        show = self.progress
+        if show is None:
+            show = sys.stderr.isatty() and self._n * total > 2e7
+        if not show or total <= 0:
+            return None
+        from tqdm.auto import tqdm
+        return tqdm(total=total, unit="step", desc="tdem", leave=False)
+
+    # ------------------------------------------------------------------ reading
+    def _particles_numpy(self, stress=True):
+        if not self._built:
+            self._build()
+        a = self._a
+        prop = a["prop"].to_numpy()
+        pos = a["pos"].to_numpy()
+        out = {
+            "position": pos, "velocity": a["vel"].to_numpy(), "omega": a["omega"].to_numpy(),
+            "radius": prop[:, 0].copy(), "mass": prop[:, 1].copy(),
+            "force": a["force"].to_numpy(), "torque": a["torque"].to_numpy(),
+            "displacement": pos - a["pos0"].to_numpy(),
+        }
+        if stress:
+            s = np.zeros((self._n, 3))
+            sa = ti.ndarray(ti.f64, (self._n, 3))
+            stepk.particle_stress(a["prop"], a["nbr"], a["ncnt"], a["cn"], a["cf"], a["cs"],
+                                  a["rev"], a["rcnt"], a["wid"], a["wcn"], a["wcf"], a["wcs"],
+                                  sa)
+            s = sa.to_numpy()
+            st = np.zeros((self._n, 2, 2))
+            st[:, 0, 0], st[:, 1, 1] = s[:, 0], s[:, 1]
+            st[:, 0, 1] = st[:, 1, 0] = s[:, 2]
+            out["stress"] = st
+            out["stress_zz"] = np.zeros(self._n)
+            out["pressure"] = -(s[:, 0] + s[:, 1]) / 3.0
+            out["plastic_strain"] = np.zeros(self._n)
+        return out
+
+    def _contacts_numpy(self):
+        """Contacts in force now: pairs (C,2) (j = -1 - wall index for walls), normal (C,)
+        compression-positive, shear (C,), moment (C,) (rolling couple on the first),
+        direction (C,2) the unit normal, overlap (C,), point (C,2)."""
+        if not self._built:
+            self._build()
+        a = self._a
+        cs = a["cs"].to_numpy()
+        nbr = a["nbr"].to_numpy()
+        hist = a["hist"].to_numpy()
+        cn = a["cn"].to_numpy()
+        pos = a["pos"].to_numpy()
+        r = a["prop"].to_numpy()[:, 0]
+        ii, kk = np.nonzero((cs[:, :, 2] > 0) & (np.arange(self._cap)[None, :] <
+                                                  a["ncnt"].to_numpy()[:, None]))
+        jj = nbr[ii, kk]
+        u = cs[ii, kk, 2]
+        normal_dir = cn[ii, kk]
+        pts = pos[ii] + (r[ii] - 0.5 * u)[:, None] * normal_dir
+        wcs = a["wcs"].to_numpy()
+        wid = a["wid"].to_numpy()
+        wi, wk = np.nonzero((wid >= 0) & (wcs[:, :, 2] > 0))
+        wu = wcs[wi, wk, 2]
+        wn = a["wcn"].to_numpy()[wi, wk]
+        whist = a["whist"].to_numpy()
+        return {
+            "pairs": np.concatenate([np.stack([ii, jj], 1),
+                                     np.stack([wi, -1 - wid[wi, wk]], 1)]).astype(np.int64),
+            "normal": np.concatenate([cs[ii, kk, 0], wcs[wi, wk, 0]]),
+            "shear": np.concatenate([cs[ii, kk, 1], wcs[wi, wk, 1]]),
+            "moment": np.concatenate([hist[ii, kk, 1], whist[wi, wk, 1]]),
+            "direction": np.concatenate([normal_dir, wn]),
+            "overlap": np.concatenate([u, wu]),
+            "point": np.concatenate([pts, pos[wi] + (r[wi] - 0.5 * wu)[:, None] * wn]),
+        }
+
+    def energy(self):
+        """Energy account (J per metre of thickness) at the last completed step:
+        kinetic, gravitational (relative to the origin), elastic (springs),
+        dissipated (damping, friction, rolling), boundary_work (done by walls and
+        prescribed velocities) and total = kinetic + gravitational + elastic +
+        dissipated − boundary_work, which is conserved."""
+        if not self._built:
+            self._build()
+        a = self._a
+        pen = a["pen"].to_numpy()
+        el = stepk.elastic_energy_sum(a["pos"], a["prop"], a["plaw"], a["nbr"], a["ncnt"],
+                                      a["hist"], a["cs"], a["wall"], a["wid"], a["whist"],
+                                      a["wcs"], a["lawp"], a["lawpair"])
+        e = {"kinetic": float(pen[:, 0].sum()), "gravitational": float(pen[:, 1].sum()),
+             "elastic": float(el), "dissipated": float(pen[:, 2].sum()),
+             "boundary_work": float(pen[:, 3].sum())}
+        e["total"] = e["kinetic"] + e["gravitational"] + e["elastic"] + e["dissipated"] \
+            - e["boundary_work"]
+        return e
+
+    # ------------------------------------------------ monitors, output, checkpoints
+    def monitor(self, name, fn, every=100):
+        """Record ``fn(sim)`` (a number or an array) every ``every`` steps under ``name``.
+
+        Histories are in :meth:`histories` and in ``monitors.h5`` when output is on.
+        """
+        from .io import Monitor
+        if any(m.name == name for m in self._monitors):
+            raise InputError(f"name: a monitor called {name!r} exists already")
+        m = Monitor(name, fn, every, start=self._steps)
+        self._monitors.append(m)
+        return m
+
+    def histories(self):
+        """{name: (times (K,), values (K, ...))} of every monitor."""
+        return {m.name: m.arrays() for m in self._monitors}
+
+    def output(self, directory, every=None, interval=None, contacts=True, walls=True,
+               checkpoint_on_abort=True):
+        """Write a VTU series (``.pvd`` index) every ``every`` steps or ``interval``
+        seconds of simulated time into ``directory``, the monitors to
+        ``directory/monitors.h5``; an interrupted or unstable run flushes them and
+        leaves ``directory/last_good.h5``."""
+        from .io import Output
+        self._output = Output(directory, every=every, interval=interval, contacts=contacts,
+                              walls=walls, checkpoint_on_abort=checkpoint_on_abort, sim=self)
+        return self._output
+
+    def write_vtu(self, path, walls=True, contacts=True):
+        """Write one snapshot: particles to ``path``; walls and contacts beside it
+        (``*_walls.vtu``, ``*_contacts.vtu``). Returns the paths written."""
+        from .io import write_vtu
+        return write_vtu(self, path, walls=walls, contacts=contacts)
+
+    def save(self, path):
+        """Checkpoint the whole state to HDF5; :meth:`load` restarts it exactly."""
+        from .checkpoint import save
+        save(self, path)
+
+    @staticmethod
+    def load(path, arch=None):
+        """Rebuild a simulation from a checkpoint written by :meth:`save`."""
+        from .checkpoint import load
+        return load(path, arch=arch)
+
+    @property
+    def n_particles(self):
+        return self._n
+
+    @property
+    def neighbour_builds(self):
+        """How many times the neighbour lists have been built."""
+        return int(self._a["flags"].to_numpy()[F_BUILDS]) if self._built else 0
+
+    def __repr__(self):
+        return (f"Simulation({self._n} particles, {len(self._walls_host)} walls, "
+                f"t={self._time:.6g} s, step {self._steps}, arch={self.arch})")
+

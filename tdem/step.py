@@ -1,0 +1,363 @@
+"""One time step of the DEM: the whole data flow in one kernel.
+
+    forces at x_n (pair contacts from the neighbour lists, wall contacts)
+      -> gather per particle (own slots + reverse slots + wall slots, no atomics)
+      -> damping, prescribed velocities, leapfrog: v_{n+1/2}, x_{n+1}
+      -> energy account at t_n, skin check (raises the rebuild flag)
+      -> walls move
+
+Conventions (spec §0–1): n points from i to j, t = n rotated +90°, F_n is
+compression-positive, the force on i is −F_n n + F_s t, ω × r = ω(−r_y, r_x).
+Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
+"""
+import taichi as ti
+
+from physics.contact_law import pair_force, elastic_energy
+from physics.rolling import rolling_couple
+
+from .neighbors import F_BAD, F_REBUILD, F_WALL_NEED
+
+# columns of the float parameter array ``simp``
+P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
+SIMP_SIZE = 8
+# columns of the wall array: p0, p1, translation velocity, angular velocity, centre, law
+W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW = range(10)
+WALL_WIDTH = 10
+# fixed-velocity bits
+FIX_VX, FIX_VY, FIX_W = 1, 2, 4
+
+
+@ti.func
+def perp(n):
+    return ti.Vector([-n[1], n[0]])
+
+
+@ti.func
+def closest_on_segment(x, a, b):
+    ab = b - a
+    ll = ab.dot(ab)
+    s = 0.0
+    if ll > 0.0:
+        s = ti.math.clamp((x - a).dot(ab) / ll, 0.0, 1.0)
+    return a + s * ab
+
+
+@ti.func
+def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.template(), prop: ti.template(), plaw: ti.template(), lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(), hist: ti.template(), cn: ti.template(), cf: ti.template(), cs: ti.template(), dt):
+    """Force of the contact in slot k of particle i; returns the dissipated energy."""
+    j = nbr[i, k]
+    xi = pos[i]
+    d = pos[j] - xi
+    dist = d.norm()
+    ri = prop[i][0]
+    rj = prop[j][0]
+    u = ri + rj - dist
+    diss = 0.0
+    if u > 0.0:
+        n = ti.Vector([1.0, 0.0])
+        if dist > 0.0:
+            n = d / dist
+        t = perp(n)
+        ai = ri - 0.5 * u
+        aj = rj - 0.5 * u
+        vrel = vel[j] - vel[i] - (omega[j] * aj + omega[i] * ai) * t
+        vn = vrel.dot(n)
+        vs = vrel.dot(t)
+        L = lawpair[plaw[i], plaw[j]]
+        mi = prop[i][1]
+        mj = prop[j][1]
+        h = hist[i, k]
+        fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
+            lawp, L, u, vn, vs, mi * mj / (mi + mj), ri * rj / (ri + rj), dt, h[0])
+        m, m_tot, th, brk, d2 = rolling_couple(
+            lawp, L, fn_el, kn, cnd, 2.0 * ri * rj / (ri + rj), omega[i] - omega[j], dt,
+            h[1], h[2], h[3])
+        f = -fn * n + fs_tot * t
+        hist[i, k] = ti.Vector([fs, m, th, brk])
+        cn[i, k] = n
+        cf[i, k] = ti.Vector([f[0], f[1], ai * fs_tot + m_tot, aj * fs_tot - m_tot])
+        cs[i, k] = ti.Vector([fn, fs_tot, u])
+        diss = d1 + d2
+    else:
+        hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+        cf[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+        cs[i, k] = ti.Vector([0.0, 0.0, u])
+    return diss
+
+
+@ti.func
+def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(), prop: ti.template(), wall: ti.template(), wforce: ti.template(), lawp: ti.template(), wid: ti.template(), whist: ti.template(), wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), flags: ti.template(), nw, dt):
+    """Contacts of particle i with every wall; returns (dissipation, work by walls)."""
+    capw = wid.shape[1]
+    xi = pos[i]
+    ri = prop[i][0]
+    diss = 0.0
+    work = 0.0
+    touching = 0
+    for w in range(nw):
+        a = ti.Vector([wall[w, W_X0], wall[w, W_Y0]])
+        b = ti.Vector([wall[w, W_X1], wall[w, W_Y1]])
+        q = closest_on_segment(xi, a, b)
+        d = q - xi
+        dist = d.norm()
+        u = ri - dist
+        s = -1
+        for kk in range(capw):
+            if wid[i, kk] == w:
+                s = kk
+        if u > 0.0:
+            touching += 1
+            if s < 0:
+                for kk in range(capw):
+                    if s < 0 and wid[i, kk] < 0:
+                        s = kk
+                if s >= 0:
+                    wid[i, s] = w
+                    whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            if s >= 0:
+                n = ti.Vector([1.0, 0.0])
+                if dist > 0.0:
+                    n = d / dist
+                t = perp(n)
+                ai = ri - 0.5 * u
+                xc = xi + ai * n
+                c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
+                ww = wall[w, W_OMEGA]
+                vw = ti.Vector([wall[w, W_VX], wall[w, W_VY]]) + ww * perp(xc - c)
+                vrel = vw - vel[i] - omega[i] * ai * t
+                vn = vrel.dot(n)
+                vs = vrel.dot(t)
+                L = ti.cast(wall[w, W_LAW], ti.i32)
+                h = whist[i, s]
+                fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
+                    lawp, L, u, vn, vs, prop[i][1], ri, dt, h[0])
+                m, m_tot, th, brk, d2 = rolling_couple(
+                    lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[1], h[2], h[3])
+                f = -fn * n + fs_tot * t
+                mi = ai * fs_tot + m_tot
+                whist[i, s] = ti.Vector([fs, m, th, brk])
+                wcn[i, s] = n
+                wcf[i, s] = ti.Vector([f[0], f[1], mi, 0.0])
+                wcs[i, s] = ti.Vector([fn, fs_tot, u])
+                diss += d1 + d2
+                work += f.dot(vw) * dt
+                r = xc - c
+                ti.atomic_add(wforce[w][0], -f[0])
+                ti.atomic_add(wforce[w][1], -f[1])
+                ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
+        elif s >= 0:
+            wid[i, s] = -1
+            whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            wcs[i, s] = ti.Vector([0.0, 0.0, 0.0])
+    if touching > capw:
+        ti.atomic_max(flags[F_WALL_NEED], touching)
+    return diss, work
+
+
+@ti.kernel
+def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
+         prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
+         vfix: ti.types.ndarray(), force: ti.types.ndarray(), torque: ti.types.ndarray(),
+         xref: ti.types.ndarray(), pen: ti.types.ndarray(),
+         nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
+         cn: ti.types.ndarray(), cf: ti.types.ndarray(), cs: ti.types.ndarray(),
+         rev: ti.types.ndarray(), rcnt: ti.types.ndarray(),
+         wall: ti.types.ndarray(), wforce: ti.types.ndarray(),
+         wid: ti.types.ndarray(), whist: ti.types.ndarray(), wcn: ti.types.ndarray(),
+         wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
+         lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
+         simp: ti.types.ndarray(), serial: ti.template()):
+    n = pos.shape[0]
+    cap = nbr.shape[1]
+    capw = wid.shape[1]
+    dt = simp[P_DT]
+    nw = ti.cast(simp[P_NWALLS], ti.i32)
+    g = ti.Vector([simp[P_GX], simp[P_GY]])
+    alpha = simp[P_ALPHA]
+    alpha_l = simp[P_ALPHA_LOCAL]
+    half_skin2 = (0.5 * simp[P_SKIN]) ** 2
+
+    ti.loop_config(serialize=True)
+    for w in range(nw):
+        wforce[w] = ti.Vector([0.0, 0.0, 0.0])
+
+    # 1. contact forces at x_n, one pair per slot (the owner is the lower index)
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        diss = 0.0
+        for k in range(ncnt[i]):
+            diss += pair_contact(i, k, pos, vel, omega, prop, plaw, lawp, lawpair, nbr, hist,
+                                 cn, cf, cs, dt)
+        dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid, whist, wcn,
+                                 wcf, wcs, flags, nw, dt)
+        e = pen[i]
+        pen[i] = ti.Vector([e[0], e[1], e[2] + diss + dw, e[3] + work])
+
+    # 2. gather, damp, integrate (leapfrog), energy at t_n, skin check
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        f = ti.Vector([0.0, 0.0])
+        tq = 0.0
+        for k in range(ncnt[i]):
+            c = cf[i, k]
+            f += ti.Vector([c[0], c[1]])
+            tq += c[2]
+        for r in range(rcnt[i]):
+            flat = rev[i, r]
+            j = flat // cap
+            k = flat - j * cap
+            c = cf[j, k]
+            f -= ti.Vector([c[0], c[1]])
+            tq += c[3]
+        for s in range(capw):
+            if wid[i, s] >= 0:
+                c = wcf[i, s]
+                f += ti.Vector([c[0], c[1]])
+                tq += c[2]
+        force[i] = f
+        torque[i] = tq
+        m = prop[i][1]
+        inertia = prop[i][2]
+        v0 = vel[i]
+        w0 = omega[i]
+        ftot = f + m * g
+        # local non-viscous damping (Miyata Eq. 33, PFC form), per component
+        fd = -alpha_l * ti.abs(ftot) * ti.math.sign(v0)
+        md = -alpha_l * ti.abs(tq) * ti.math.sign(w0)
+        # global mass-proportional damping (C&S Eqs. 34–36)
+        den = 1.0 + 0.5 * alpha * dt
+        num = 1.0 - 0.5 * alpha * dt
+        v1 = (v0 * num + (ftot + fd) / m * dt) / den
+        w1 = (w0 * num + (tq + md) / inertia * dt) / den
+        vfree = v1
+        wfree = w1
+        fx = fix[i]
+        if fx != 0:
+            vf = vfix[i]
+            if fx & 1:
+                v1[0] = vf[0]
+            if fx & 2:
+                v1[1] = vf[1]
+            if fx & 4:
+                w1 = vf[2]
+        vm = 0.5 * (v0 + v1)
+        wm = 0.5 * (w0 + w1)
+        x0 = pos[i]
+        e = pen[i]
+        ekin = 0.5 * m * vm.dot(vm) + 0.5 * inertia * wm * wm
+        egrav = -m * g.dot(x0)
+        edis = e[2] + (alpha * (m * vm.dot(vm) + inertia * wm * wm) - fd.dot(vm) - md * wm) * dt
+        # work of the constraint that imposes prescribed velocities
+        ework = e[3] + m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm
+        pen[i] = ti.Vector([ekin, egrav, edis, ework])
+        x1 = x0 + v1 * dt
+        vel[i] = v1
+        omega[i] = w1
+        pos[i] = x1
+        dx = x1 - xref[i]
+        if dx.dot(dx) > half_skin2:
+            flags[F_REBUILD] = 1
+
+    # 3. walls move: rotation about their centre, then translation
+    ti.loop_config(serialize=True)
+    for w in range(nw):
+        c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
+        v = ti.Vector([wall[w, W_VX], wall[w, W_VY]])
+        ang = wall[w, W_OMEGA] * dt
+        rot = ti.Matrix([[ti.cos(ang), -ti.sin(ang)], [ti.sin(ang), ti.cos(ang)]])
+        p0 = c + v * dt + rot @ (ti.Vector([wall[w, W_X0], wall[w, W_Y0]]) - c)
+        p1 = c + v * dt + rot @ (ti.Vector([wall[w, W_X1], wall[w, W_Y1]]) - c)
+        wall[w, W_X0] = p0[0]
+        wall[w, W_Y0] = p0[1]
+        wall[w, W_X1] = p1[0]
+        wall[w, W_Y1] = p1[1]
+        wall[w, W_CX] = c[0] + v[0] * dt
+        wall[w, W_CY] = c[1] + v[1] * dt
+
+
+@ti.kernel
+def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
+                    omega: ti.types.ndarray(), prop: ti.types.ndarray(),
+                    flags: ti.types.ndarray(), dt: ti.f64):
+    """flags[F_BAD] = smallest index of a particle with a non-finite state or moving
+    more than half its radius in one step."""
+    n = pos.shape[0]
+    flags[F_BAD] = n
+    for i in range(n):
+        x = pos[i]
+        v = vel[i]
+        w = omega[i]
+        s = x[0] + x[1] + v[0] + v[1] + w
+        bad = not (s == s) or ti.abs(s) > 1e300
+        if not bad:
+            bad = v.norm() * dt > 0.5 * prop[i][0]
+        if bad:
+            ti.atomic_min(flags[F_BAD], i)
+
+
+@ti.kernel
+def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
+                       plaw: ti.types.ndarray(), nbr: ti.types.ndarray(),
+                       ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
+                       cs: ti.types.ndarray(), wall: ti.types.ndarray(),
+                       wid: ti.types.ndarray(), whist: ti.types.ndarray(),
+                       wcs: ti.types.ndarray(), lawp: ti.types.ndarray(),
+                       lawpair: ti.types.ndarray()) -> ti.f64:
+    total = 0.0
+    for i in range(pos.shape[0]):
+        ri = prop[i][0]
+        for k in range(ncnt[i]):
+            u = cs[i, k][2]
+            if u > 0.0:
+                j = nbr[i, k]
+                rj = prop[j][0]
+                L = lawpair[plaw[i], plaw[j]]
+                h = hist[i, k]
+                total += elastic_energy(lawp, L, u, ri * rj / (ri + rj), h[0], h[1],
+                                        2.0 * ri * rj / (ri + rj))
+        for s in range(wid.shape[1]):
+            w = wid[i, s]
+            if w >= 0:
+                u = wcs[i, s][2]
+                if u > 0.0:
+                    h = whist[i, s]
+                    total += elastic_energy(lawp, ti.cast(wall[w, W_LAW], ti.i32), u, ri,
+                                            h[0], h[1], 2.0 * ri)
+    return total
+
+
+@ti.kernel
+def particle_stress(prop: ti.types.ndarray(), nbr: ti.types.ndarray(),
+                    ncnt: ti.types.ndarray(), cn: ti.types.ndarray(), cf: ti.types.ndarray(),
+                    cs: ti.types.ndarray(), rev: ti.types.ndarray(), rcnt: ti.types.ndarray(),
+                    wid: ti.types.ndarray(), wcn: ti.types.ndarray(), wcf: ti.types.ndarray(),
+                    wcs: ti.types.ndarray(), out: ti.types.ndarray()):
+    """Average stress of each disc, σ = (1/(π R²)) Σ_c sym(r_c ⊗ f_c), tension-positive."""
+    cap = nbr.shape[1]
+    for i in range(prop.shape[0]):
+        ri = prop[i][0]
+        s = ti.Matrix([[0.0, 0.0], [0.0, 0.0]])
+        for k in range(ncnt[i]):
+            u = cs[i, k][2]
+            if u > 0.0:
+                c = cf[i, k]
+                s += (ri - 0.5 * u) * cn[i, k].outer_product(ti.Vector([c[0], c[1]]))
+        for r in range(rcnt[i]):
+            flat = rev[i, r]
+            j = flat // cap
+            k = flat - j * cap
+            u = cs[j, k][2]
+            if u > 0.0:
+                c = cf[j, k]
+                # r = −(R_i − u/2) n, f = −f_owner
+                s += (ri - 0.5 * u) * cn[j, k].outer_product(ti.Vector([c[0], c[1]]))
+        for q in range(wid.shape[1]):
+            if wid[i, q] >= 0:
+                u = wcs[i, q][2]
+                c = wcf[i, q]
+                s += (ri - 0.5 * u) * wcn[i, q].outer_product(ti.Vector([c[0], c[1]]))
+        s = 0.5 * (s + s.transpose()) / (ti.math.pi * ri * ri)
+        out[i, 0] = s[0, 0]
+        out[i, 1] = s[1, 1]
+        out[i, 2] = s[0, 1]
