@@ -32,15 +32,15 @@ MAX_SLOTS = 1024
 # name: (components, per-slot?, dtype kind). components 0 = scalar.
 _PARTICLE = {
     "pos": 2, "vel": 2, "omega": 0, "prop": 3, "plaw": "i", "fix": "i", "vfix": 3,
-    "force": 2, "torque": 0, "xref": 2, "pen": 4, "pos0": 2,
+    "force": 2, "torque": 0, "xref": 2, "pos0": 2, "facc": 5, "eacc": 2, "estate": 2,
 }
-_SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 4, "cs": 3, "rev": "i",
+_SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
           "nbr_old": "i", "hist_old": 4}
 _COUNTS = ("ncnt", "rcnt", "ncnt_old")
 _WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3}
 # arrays rebuilt from scratch whenever needed (never saved or restored)
 _SCRATCH = ("cell_count", "cell_start", "sorted", "pcell", "bounds", "nbr_old", "hist_old",
-            "ncnt_old", "simp", "lawp", "lawpair")
+            "ncnt_old", "simp", "lawp", "lawpair", "facc")
 
 
 def _as_xy(name, value, n=None):
@@ -478,7 +478,7 @@ class Simulation:
             "plaw": np.concatenate(self._host["law"]).astype(np.int32),
             "fix": np.zeros(n, np.int32), "vfix": np.zeros((n, 3)),
             "force": np.zeros((n, 2)), "torque": np.zeros(n), "xref": pos.copy(),
-            "pen": np.zeros((n, 4)),
+            "eacc": np.zeros((n, 2)), "estate": np.zeros((n, 2)),
             "nbr": -np.ones((n, self._cap), np.int32), "ncnt": np.zeros(n, np.int32),
             "hist": np.zeros((n, self._cap, 4)),
             "wid": -np.ones((n, self._capw), np.int32),
@@ -502,7 +502,8 @@ class Simulation:
                    "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
                    "plaw": np.full(n, law, np.int32), "fix": np.zeros(n, np.int32),
                    "vfix": np.zeros((n, 3)), "force": np.zeros((n, 2)), "torque": np.zeros(n),
-                   "xref": pos.copy(), "pen": np.zeros((n, 4)),
+                   "xref": pos.copy(), "eacc": np.zeros((n, 2)),
+                   "estate": np.zeros((n, 2)),
                    "nbr": -np.ones((n, state["nbr"].shape[1]), np.int32),
                    "ncnt": np.zeros(n, np.int32),
                    "hist": np.zeros((n, state["hist"].shape[1], 4)),
@@ -653,10 +654,13 @@ class Simulation:
     def _step_args(self):
         a = self._a
         return (a["pos"], a["vel"], a["omega"], a["prop"], a["plaw"], a["fix"], a["vfix"],
-                a["force"], a["torque"], a["xref"], a["pen"], a["nbr"], a["ncnt"], a["hist"],
+                a["force"], a["torque"], a["xref"], a["facc"], a["eacc"], a["estate"],
+                a["nbr"], a["ncnt"], a["hist"],
                 a["cn"], a["cf"], a["cs"], a["rev"], a["rcnt"], a["wall"], a["wforce"],
                 a["wid"], a["whist"], a["wcn"], a["wcf"], a["wcs"], a["lawp"], a["lawpair"],
                 a["flags"], a["simp"], backend.serial_loops())
+
+
 
     def _rebuild_args(self):
         a = self._a
@@ -665,12 +669,12 @@ class Simulation:
                 a["cell_start"], a["sorted"], a["pcell"], a["gridp"], a["gridn"], a["flags"],
                 float(self.skin))
 
-    def _one_step(self, step_args, rebuild_args, on_cpu):
+    def _one_step(self, step_args, rebuild_args, on_cpu, detail):
         if self._fix_fn:
             self._apply_fixes(t=self._time)
         if not on_cpu or self._a["flags"][F_REBUILD] != 0:
             neighbors.rebuild(*rebuild_args)
-        stepk.step(*step_args)
+        stepk.step(*step_args, detail)
         self._time += self._dt_run
         self._steps += 1
 
@@ -773,8 +777,10 @@ class Simulation:
         self._take_snapshot()
         sargs, rargs = self._step_args(), self._rebuild_args()
         on_cpu = self.arch == "cpu"
-        for _ in range(n):
-            self._one_step(sargs, rargs, on_cpu)
+        for s in range(n):
+            # output-only quantities are stored on the steps something will read them
+            detail = s == n - 1 or self._steps + 1 >= self._next_event
+            self._one_step(sargs, rargs, on_cpu, detail)
             if self._steps >= self._next_event:
                 self._events()
         flags = self._status()
@@ -794,7 +800,7 @@ class Simulation:
         on_cpu = self.arch == "cpu"
         for _ in range(self.check_interval + 1):
             self._take_snapshot()
-            self._one_step(sargs, rargs, on_cpu)
+            self._one_step(sargs, rargs, on_cpu, True)
             flags = self._status()
             if flags[F_BAD] < self._n:
                 k = int(flags[F_BAD])
@@ -912,13 +918,14 @@ class Simulation:
         if not self._built:
             self._build()
         a = self._a
-        pen = a["pen"].to_numpy()
+        eacc = a["eacc"].to_numpy()
+        estate = a["estate"].to_numpy()
         el = stepk.elastic_energy_sum(a["pos"], a["prop"], a["plaw"], a["nbr"], a["ncnt"],
                                       a["hist"], a["cs"], a["wall"], a["wid"], a["whist"],
                                       a["wcs"], a["lawp"], a["lawpair"])
-        e = {"kinetic": float(pen[:, 0].sum()), "gravitational": float(pen[:, 1].sum()),
-             "elastic": float(el), "dissipated": float(pen[:, 2].sum()),
-             "boundary_work": float(pen[:, 3].sum())}
+        e = {"kinetic": float(estate[:, 0].sum()), "gravitational": float(estate[:, 1].sum()),
+             "elastic": float(el), "dissipated": float(eacc[:, 0].sum()),
+             "boundary_work": float(eacc[:, 1].sum())}
         e["total"] = e["kinetic"] + e["gravitational"] + e["elastic"] + e["dissipated"] \
             - e["boundary_work"]
         return e

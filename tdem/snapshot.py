@@ -6,7 +6,8 @@ whatever the size of the system.
 import taichi as ti
 
 # order of the arrays passed to :func:`copy_state` (sources, then destinations)
-PER_PARTICLE = ("pos", "vel", "omega", "force", "torque", "xref", "pen", "ncnt", "rcnt")
+PER_PARTICLE = ("pos", "vel", "omega", "force", "torque", "xref", "eacc", "estate", "ncnt",
+                "rcnt")
 PER_SLOT = ("nbr", "hist", "cn", "cf", "cs", "rev")
 PER_WALL_SLOT = ("wid", "whist", "wcn", "wcf", "wcs")
 OTHER = ("wall", "wforce", "flags")
@@ -17,7 +18,7 @@ ORDER = PER_PARTICLE + PER_SLOT + PER_WALL_SLOT + OTHER
 def copy_state(a0: ti.types.ndarray(), a1: ti.types.ndarray(), a2: ti.types.ndarray(),
                a3: ti.types.ndarray(), a4: ti.types.ndarray(), a5: ti.types.ndarray(),
                a6: ti.types.ndarray(), a7: ti.types.ndarray(), a8: ti.types.ndarray(),
-               s0: ti.types.ndarray(), s1: ti.types.ndarray(), s2: ti.types.ndarray(),
+               a9: ti.types.ndarray(), s0: ti.types.ndarray(), s1: ti.types.ndarray(), s2: ti.types.ndarray(),
                s3: ti.types.ndarray(), s4: ti.types.ndarray(), s5: ti.types.ndarray(),
                w0: ti.types.ndarray(), w1: ti.types.ndarray(), w2: ti.types.ndarray(),
                w3: ti.types.ndarray(), w4: ti.types.ndarray(),
@@ -25,7 +26,7 @@ def copy_state(a0: ti.types.ndarray(), a1: ti.types.ndarray(), a2: ti.types.ndar
                b0: ti.types.ndarray(), b1: ti.types.ndarray(), b2: ti.types.ndarray(),
                b3: ti.types.ndarray(), b4: ti.types.ndarray(), b5: ti.types.ndarray(),
                b6: ti.types.ndarray(), b7: ti.types.ndarray(), b8: ti.types.ndarray(),
-               t0: ti.types.ndarray(), t1: ti.types.ndarray(), t2: ti.types.ndarray(),
+               b9: ti.types.ndarray(), t0: ti.types.ndarray(), t1: ti.types.ndarray(), t2: ti.types.ndarray(),
                t3: ti.types.ndarray(), t4: ti.types.ndarray(), t5: ti.types.ndarray(),
                v0: ti.types.ndarray(), v1: ti.types.ndarray(), v2: ti.types.ndarray(),
                v3: ti.types.ndarray(), v4: ti.types.ndarray(),
@@ -43,6 +44,7 @@ def copy_state(a0: ti.types.ndarray(), a1: ti.types.ndarray(), a2: ti.types.ndar
         b6[i] = a6[i]
         b7[i] = a7[i]
         b8[i] = a8[i]
+        b9[i] = a9[i]
         for k in range(s0.shape[1]):
             t0[i, k] = s0[i, k]
             t1[i, k] = s1[i, k]

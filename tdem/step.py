@@ -1,7 +1,8 @@
 """One time step of the DEM: the whole data flow in one kernel.
 
-    forces at x_n (pair contacts from the neighbour lists, wall contacts)
-      -> gather per particle (own slots + reverse slots + wall slots, no atomics)
+    forces at x_n (pair contacts from the neighbour lists, wall contacts),
+      summed per owner particle; each pair slot keeps the partner's share
+      -> gather per particle (own sum + reverse slots, no atomics)
       -> damping, prescribed velocities, leapfrog: v_{n+1/2}, x_{n+1}
       -> energy account at t_n, skin check (raises the rebuild flag)
       -> walls move
@@ -43,8 +44,16 @@ def closest_on_segment(x, a, b):
 
 
 @ti.func
-def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.template(), prop: ti.template(), plaw: ti.template(), lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(), hist: ti.template(), cn: ti.template(), cf: ti.template(), cs: ti.template(), dt):
-    """Force of the contact in slot k of particle i; returns the dissipated energy."""
+def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.template(),
+                 prop: ti.template(), plaw: ti.template(), lawp: ti.template(),
+                 lawpair: ti.template(), nbr: ti.template(), hist: ti.template(),
+                 cn: ti.template(), cf: ti.template(), cs: ti.template(), dt,
+                 detail: ti.template()):
+    """Contact in slot k of particle i (the owner, i < j).
+
+    Updates the history, stores (f_i, M_j) in the slot for j's gather and returns
+    (f_i, M_i, dissipated energy). With ``detail`` also stores the normal, the
+    scalar forces and the overlap (for output, stress and energy)."""
     j = nbr[i, k]
     xi = pos[i]
     d = pos[j] - xi
@@ -52,6 +61,8 @@ def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.templat
     ri = prop[i][0]
     rj = prop[j][0]
     u = ri + rj - dist
+    f = ti.Vector([0.0, 0.0])
+    mi = 0.0
     diss = 0.0
     if u > 0.0:
         n = ti.Vector([1.0, 0.0])
@@ -64,36 +75,50 @@ def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.templat
         vn = vrel.dot(n)
         vs = vrel.dot(t)
         L = lawpair[plaw[i], plaw[j]]
-        mi = prop[i][1]
-        mj = prop[j][1]
+        m_i = prop[i][1]
+        m_j = prop[j][1]
         h = hist[i, k]
         fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
-            lawp, L, u, vn, vs, mi * mj / (mi + mj), ri * rj / (ri + rj), dt, h[0])
+            lawp, L, u, vn, vs, m_i * m_j / (m_i + m_j), ri * rj / (ri + rj), dt, h[0])
         m, m_tot, th, brk, d2 = rolling_couple(
             lawp, L, fn_el, kn, cnd, 2.0 * ri * rj / (ri + rj), omega[i] - omega[j], dt,
             h[1], h[2], h[3])
         f = -fn * n + fs_tot * t
+        mi = ai * fs_tot + m_tot
         hist[i, k] = ti.Vector([fs, m, th, brk])
-        cn[i, k] = n
-        cf[i, k] = ti.Vector([f[0], f[1], ai * fs_tot + m_tot, aj * fs_tot - m_tot])
-        cs[i, k] = ti.Vector([fn, fs_tot, u])
+        cf[i, k] = ti.Vector([f[0], f[1], aj * fs_tot - m_tot])
         diss = d1 + d2
+        if ti.static(detail):
+            cn[i, k] = n
+            cs[i, k] = ti.Vector([fn, fs_tot, u])
     else:
         hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
-        cf[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
-        cs[i, k] = ti.Vector([0.0, 0.0, u])
-    return diss
+        cf[i, k] = ti.Vector([0.0, 0.0, 0.0])
+        if ti.static(detail):
+            cs[i, k] = ti.Vector([0.0, 0.0, u])
+    return f, mi, diss
 
 
 @ti.func
-def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(), prop: ti.template(), wall: ti.template(), wforce: ti.template(), lawp: ti.template(), wid: ti.template(), whist: ti.template(), wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), flags: ti.template(), nw, dt):
-    """Contacts of particle i with every wall; returns (dissipation, work by walls)."""
+def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
+                  prop: ti.template(), wall: ti.template(), wforce: ti.template(),
+                  lawp: ti.template(), wid: ti.template(), whist: ti.template(),
+                  wcn: ti.template(), wcf: ti.template(), wcs: ti.template(),
+                  flags: ti.template(), nw, dt):
+    """Contacts of particle i with every wall (the wall is 'j', of infinite radius and
+    mass); returns (force on i, moment on i, dissipation, work done by the walls)."""
     capw = wid.shape[1]
     xi = pos[i]
     ri = prop[i][0]
     diss = 0.0
     work = 0.0
+    ftot = ti.Vector([0.0, 0.0])
+    mtot = 0.0
     touching = 0
+    held = 0
+    for kk in range(capw):
+        if wid[i, kk] >= 0:
+            held += 1
     for w in range(nw):
         a = ti.Vector([wall[w, W_X0], wall[w, W_Y0]])
         b = ti.Vector([wall[w, W_X1], wall[w, W_Y1]])
@@ -102,9 +127,10 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         dist = d.norm()
         u = ri - dist
         s = -1
-        for kk in range(capw):
-            if wid[i, kk] == w:
-                s = kk
+        if held > 0 or u > 0.0:
+            for kk in range(capw):
+                if wid[i, kk] == w:
+                    s = kk
         if u > 0.0:
             touching += 1
             if s < 0:
@@ -141,6 +167,8 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                 wcs[i, s] = ti.Vector([fn, fs_tot, u])
                 diss += d1 + d2
                 work += f.dot(vw) * dt
+                ftot += f
+                mtot += mi
                 r = xc - c
                 ti.atomic_add(wforce[w][0], -f[0])
                 ti.atomic_add(wforce[w][1], -f[1])
@@ -152,14 +180,15 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             wcs[i, s] = ti.Vector([0.0, 0.0, 0.0])
     if touching > capw:
         ti.atomic_max(flags[F_WALL_NEED], touching)
-    return diss, work
+    return ftot, mtot, diss, work
 
 
 @ti.kernel
 def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
          prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
          vfix: ti.types.ndarray(), force: ti.types.ndarray(), torque: ti.types.ndarray(),
-         xref: ti.types.ndarray(), pen: ti.types.ndarray(),
+         xref: ti.types.ndarray(), facc: ti.types.ndarray(), eacc: ti.types.ndarray(),
+         estate: ti.types.ndarray(),
          nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
          cn: ti.types.ndarray(), cf: ti.types.ndarray(), cs: ti.types.ndarray(),
          rev: ti.types.ndarray(), rcnt: ti.types.ndarray(),
@@ -167,10 +196,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          wid: ti.types.ndarray(), whist: ti.types.ndarray(), wcn: ti.types.ndarray(),
          wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
-         simp: ti.types.ndarray(), serial: ti.template()):
+         simp: ti.types.ndarray(), serial: ti.template(), detail: ti.template()):
+    """One step. ``detail`` (a compile-time switch) also stores what only output
+    reads: per-contact normals, scalar forces and overlaps, particle forces, and
+    the kinetic and gravitational energy at t_n. The host asks for it on the last
+    step before anything looks at the state."""
     n = pos.shape[0]
     cap = nbr.shape[1]
-    capw = wid.shape[1]
     dt = simp[P_DT]
     nw = ti.cast(simp[P_NWALLS], ti.i32)
     g = ti.Vector([simp[P_GX], simp[P_GY]])
@@ -182,41 +214,35 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     for w in range(nw):
         wforce[w] = ti.Vector([0.0, 0.0, 0.0])
 
-    # 1. contact forces at x_n, one pair per slot (the owner is the lower index)
-    ti.loop_config(serialize=serial)
-    for i in range(n):
-        diss = 0.0
-        for k in range(ncnt[i]):
-            diss += pair_contact(i, k, pos, vel, omega, prop, plaw, lawp, lawpair, nbr, hist,
-                                 cn, cf, cs, dt)
-        dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid, whist, wcn,
-                                 wcf, wcs, flags, nw, dt)
-        e = pen[i]
-        pen[i] = ti.Vector([e[0], e[1], e[2] + diss + dw, e[3] + work])
-
-    # 2. gather, damp, integrate (leapfrog), energy at t_n, skin check
+    # 1. contact forces at x_n: each pair once, in its owner's slot (owner = lower index)
     ti.loop_config(serialize=serial)
     for i in range(n):
         f = ti.Vector([0.0, 0.0])
         tq = 0.0
+        diss = 0.0
         for k in range(ncnt[i]):
-            c = cf[i, k]
-            f += ti.Vector([c[0], c[1]])
-            tq += c[2]
+            fk, mk, dk = pair_contact(i, k, pos, vel, omega, prop, plaw, lawp, lawpair, nbr,
+                                      hist, cn, cf, cs, dt, detail)
+            f += fk
+            tq += mk
+            diss += dk
+        fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
+                                         whist, wcn, wcf, wcs, flags, nw, dt)
+        facc[i] = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw, diss + dw, work])
+
+    # 2. gather the partners' share, damp, integrate (leapfrog), skin check
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        a = facc[i]
+        f = ti.Vector([a[0], a[1]])
+        tq = a[2]
         for r in range(rcnt[i]):
             flat = rev[i, r]
             j = flat // cap
             k = flat - j * cap
             c = cf[j, k]
             f -= ti.Vector([c[0], c[1]])
-            tq += c[3]
-        for s in range(capw):
-            if wid[i, s] >= 0:
-                c = wcf[i, s]
-                f += ti.Vector([c[0], c[1]])
-                tq += c[2]
-        force[i] = f
-        torque[i] = tq
+            tq += c[2]
         m = prop[i][1]
         inertia = prop[i][2]
         v0 = vel[i]
@@ -241,16 +267,21 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 v1[1] = vf[1]
             if fx & 4:
                 w1 = vf[2]
+        # energy at t_n with the mid-point velocities
         vm = 0.5 * (v0 + v1)
         wm = 0.5 * (w0 + w1)
         x0 = pos[i]
-        e = pen[i]
-        ekin = 0.5 * m * vm.dot(vm) + 0.5 * inertia * wm * wm
-        egrav = -m * g.dot(x0)
-        edis = e[2] + (alpha * (m * vm.dot(vm) + inertia * wm * wm) - fd.dot(vm) - md * wm) * dt
-        # work of the constraint that imposes prescribed velocities
-        ework = e[3] + m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm
-        pen[i] = ti.Vector([ekin, egrav, edis, ework])
+        e = eacc[i]
+        edis = e[0] + a[3] + (alpha * (m * vm.dot(vm) + inertia * wm * wm)
+                              - fd.dot(vm) - md * wm) * dt
+        # work of the walls and of the constraint that imposes prescribed velocities
+        ework = e[1] + a[4] + m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm
+        eacc[i] = ti.Vector([edis, ework])
+        if ti.static(detail):
+            force[i] = f
+            torque[i] = tq
+            estate[i] = ti.Vector([0.5 * m * vm.dot(vm) + 0.5 * inertia * wm * wm,
+                                   -m * g.dot(x0)])
         x1 = x0 + v1 * dt
         vel[i] = v1
         omega[i] = w1
