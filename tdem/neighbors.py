@@ -34,6 +34,16 @@ FLAGS_SIZE = 8
 
 
 @ti.func
+def slot_bits(cap):
+    """log2 of the slot capacity (always a power of two): a reverse-list entry packs
+    (owner j, slot k) as j << bits | k."""
+    b = 0
+    while (1 << b) < cap:
+        b += 1
+    return b
+
+
+@ti.func
 def cell_of(x, gridp: ti.template(), nx: ti.i32, ny: ti.i32):
     cx = ti.cast(ti.floor((x[0] - gridp[0]) / gridp[2]), ti.i32)
     cy = ti.cast(ti.floor((x[1] - gridp[1]) / gridp[2]), ti.i32)
@@ -151,7 +161,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                 i = nbr[j, k]
                 r = ti.atomic_add(rcnt[i], 1)
                 if r < cap:
-                    rev[i, r] = j * cap + k
+                    rev[i, r] = (j << slot_bits(cap)) | k
     for i in range(n):
         if flags[F_REBUILD] != 0:
             m = ti.min(rcnt[i], cap)

@@ -305,7 +305,9 @@ class Simulation:
         if not math.isfinite(w):
             raise InputError(f"angular_velocity must be finite, got {angular_velocity!r}")
         law = self._law_id(contact)
-        row = np.array([a[0], a[1], b[0], b[1], v[0], v[1], w, c[0], c[1], law], dtype=float)
+        row = np.zeros(stepk.WALL_WIDTH)
+        row[:stepk.W_INVLL + 1] = [a[0], a[1], b[0], b[1], v[0], v[1], w, c[0], c[1], law,
+                                   1.0 / float(np.dot(b - a, b - a))]
         if self._built:
             state = self._download()
             self._walls_host.append(row)
@@ -712,7 +714,7 @@ class Simulation:
         need, needw = int(flags[F_NEED]), int(flags[F_WALL_NEED])
         state = self._download()
         if need > self._cap:
-            new = max(need + 2, int(self._cap * 1.5))
+            new = 1 << int(math.ceil(math.log2(need + 1)))  # a power of two
             if new > MAX_SLOTS:
                 raise CapacityError(f"a particle has {need} neighbours within its cut-off; more "
                                     f"than {MAX_SLOTS} slots are not supported (check radii and "
@@ -732,6 +734,8 @@ class Simulation:
                              f"steps={steps!r}")
         if not self._built:
             self._build()
+        if self._dt_user is not None:
+            self._check_dt_value(self._dt_user)  # particles or laws may have changed since
         self._upload_params()
         dt = self._dt_run
         if steps is not None:

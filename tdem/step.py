@@ -16,14 +16,14 @@ import taichi as ti
 from physics.contact_law import pair_force, elastic_energy
 from physics.rolling import rolling_couple
 
-from .neighbors import F_BAD, F_REBUILD, F_WALL_NEED
+from .neighbors import F_BAD, F_REBUILD, F_WALL_NEED, slot_bits
 
 # columns of the float parameter array ``simp``
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
 SIMP_SIZE = 8
 # columns of the wall array: p0, p1, translation velocity, angular velocity, centre, law
-W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW = range(10)
-WALL_WIDTH = 10
+W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW, W_INVLL = range(11)
+WALL_WIDTH = 12
 # fixed-velocity bits
 FIX_VX, FIX_VY, FIX_W = 1, 2, 4
 
@@ -34,12 +34,10 @@ def perp(n):
 
 
 @ti.func
-def closest_on_segment(x, a, b):
+def closest_on_segment(x, a, b, inv_ll):
+    """Closest point to x on segment ab; inv_ll = 1/|b − a|² (rotation keeps it)."""
     ab = b - a
-    ll = ab.dot(ab)
-    s = 0.0
-    if ll > 0.0:
-        s = ti.math.clamp((x - a).dot(ab) / ll, 0.0, 1.0)
+    s = ti.math.clamp((x - a).dot(ab) * inv_ll, 0.0, 1.0)
     return a + s * ab
 
 
@@ -122,15 +120,17 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
     for w in range(nw):
         a = ti.Vector([wall[w, W_X0], wall[w, W_Y0]])
         b = ti.Vector([wall[w, W_X1], wall[w, W_Y1]])
-        q = closest_on_segment(xi, a, b)
+        q = closest_on_segment(xi, a, b, wall[w, W_INVLL])
         d = q - xi
-        dist = d.norm()
+        d2 = d.dot(d)
+        if held == 0 and d2 >= ri * ri:
+            continue
+        dist = ti.sqrt(d2)
         u = ri - dist
         s = -1
-        if held > 0 or u > 0.0:
-            for kk in range(capw):
-                if wid[i, kk] == w:
-                    s = kk
+        for kk in range(capw):
+            if wid[i, kk] == w:
+                s = kk
         if u > 0.0:
             touching += 1
             if s < 0:
@@ -203,6 +203,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     step before anything looks at the state."""
     n = pos.shape[0]
     cap = nbr.shape[1]
+    bits = slot_bits(cap)
     dt = simp[P_DT]
     nw = ti.cast(simp[P_NWALLS], ti.i32)
     g = ti.Vector([simp[P_GX], simp[P_GY]])
@@ -238,8 +239,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         tq = a[2]
         for r in range(rcnt[i]):
             flat = rev[i, r]
-            j = flat // cap
-            k = flat - j * cap
+            j = flat >> bits
+            k = flat & (cap - 1)
             c = cf[j, k]
             f -= ti.Vector([c[0], c[1]])
             tq += c[2]
@@ -366,6 +367,7 @@ def particle_stress(prop: ti.types.ndarray(), nbr: ti.types.ndarray(),
                     wcs: ti.types.ndarray(), out: ti.types.ndarray()):
     """Average stress of each disc, σ = (1/(π R²)) Σ_c sym(r_c ⊗ f_c), tension-positive."""
     cap = nbr.shape[1]
+    bits = slot_bits(cap)
     for i in range(prop.shape[0]):
         ri = prop[i][0]
         s = ti.Matrix([[0.0, 0.0], [0.0, 0.0]])
@@ -376,8 +378,8 @@ def particle_stress(prop: ti.types.ndarray(), nbr: ti.types.ndarray(),
                 s += (ri - 0.5 * u) * cn[i, k].outer_product(ti.Vector([c[0], c[1]]))
         for r in range(rcnt[i]):
             flat = rev[i, r]
-            j = flat // cap
-            k = flat - j * cap
+            j = flat >> bits
+            k = flat & (cap - 1)
             u = cs[j, k][2]
             if u > 0.0:
                 c = cf[j, k]

@@ -1,0 +1,78 @@
+"""Engine mechanics: kernels compiled once per process, slot growth, Verlet skin."""
+import numpy as np
+import pytest
+
+import tdem
+import tdem.neighbors as nb
+import tdem.step as stepk
+
+
+def _n_compiled(kernel):
+    return len(kernel._primal.compiled_kernel_data_by_key) if hasattr(
+        kernel._primal, "compiled_kernel_data_by_key") else len(kernel._primal.compiled_kernels)
+
+
+def _box(n_side, r, seed=0, law=None):
+    rng = np.random.default_rng(seed)
+    law = law or tdem.LinearContact(kn=1e5, friction=0.3, restitution=0.8)
+    sim = tdem.Simulation(gravity=(0.0, -9.81))
+    xs = (np.arange(n_side) + 0.5) * 2.2 * r
+    pos = np.array([(x, y) for y in xs for x in xs]) + rng.uniform(-0.05, 0.05, (n_side ** 2, 2)) * r
+    sim.add_particles(pos, r, density=1000.0, contact=law,
+                      velocity=rng.normal(0.0, 0.1, (n_side ** 2, 2)))
+    w = n_side * 2.2 * r
+    for a, b in (((0, 0), (w, 0)), ((w, 0), (w, 2 * w)), ((0, 2 * w), (0, 0))):
+        sim.add_wall(a, b, contact=law)
+    return sim
+
+
+def test_second_simulation_reuses_compiled_kernels():
+    s1 = _box(6, 0.01)
+    s1.run(steps=50)
+    before = (_n_compiled(stepk.step), _n_compiled(nb.rebuild))
+    s2 = _box(11, 0.02, seed=1)   # other size, other radius
+    s2.run(steps=50)
+    after = (_n_compiled(stepk.step), _n_compiled(nb.rebuild))
+    assert after == before
+
+
+def test_slots_grow_and_steps_are_redone():
+    """A polydisperse pack whose large discs have more neighbours than the initial slots:
+    the run grows the slots, and the result equals a run that started with enough."""
+    pos, rad = [], []
+    for i in range(28):
+        for j in range(28):
+            pos.append((i * 0.012, j * 0.012))
+            rad.append(0.004)
+    pos = np.array(pos)
+    big = np.array([[0.165, 0.165]])
+    keep = np.linalg.norm(pos - big, axis=1) > 0.06 + 0.004 + 0.002
+    pos, rad = pos[keep], np.array(rad)[keep]
+    law = tdem.LinearContact(kn=1e5, friction=0.3)
+
+    def make(cap):
+        sim = tdem.Simulation(gravity=(0.0, 0.0), dt=1e-4, check_interval=20)
+        sim._cap = cap
+        sim.add_particles(pos, rad, density=1000.0, contact=law,
+                          velocity=1.0 * (big - pos) / np.linalg.norm(big - pos, axis=1)[:, None])
+        sim.add_particles(big, 0.06, density=1000.0, contact=law)
+        return sim
+
+    small = make(8)
+    small.run(steps=400)
+    assert small._cap > 8
+    ref = make(64)
+    ref.run(steps=400)
+    a, b = small.particles.numpy(), ref.particles.numpy()
+    np.testing.assert_allclose(a["position"], b["position"], rtol=0, atol=1e-12)
+
+
+def test_lists_rebuilt_only_after_half_skin():
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt=1e-3, skin=0.01)
+    law = tdem.LinearContact(kn=1e3)
+    sim.add_particles([[0.0, 0.0], [1.0, 0.0]], 0.1, density=1.0, contact=law,
+                      velocity=[[1.0, 0.0], [0.0, 0.0]])
+    sim.run(steps=1)
+    b0 = sim.neighbour_builds
+    sim.run(steps=100)   # the first disc moves 0.1 m: one rebuild per 0.005 m
+    assert sim.neighbour_builds - b0 == pytest.approx(100 * 1e-3 / 0.005, abs=1)
