@@ -15,6 +15,10 @@ since the last build; the integrator raises a flag on the device. On the GPU the
 rebuild kernel is launched every step and does nothing unless the flag is up; on
 the CPU the host reads the flag (shared memory, no transfer).
 
+Each particle also lists its candidate walls (within R + skin); a wall that has
+moved half the skin since the build raises the flag too, so relative motion never
+exceeds the skin between builds.
+
 Out-of-grid particles are clamped to the border cells: this keeps the search
 exact (clamping never separates two cells by more than one), only slower, until
 the host refits the grid at its next check.
@@ -58,6 +62,8 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             cell_count: ti.types.ndarray(), cell_start: ti.types.ndarray(),
             sorted_ids: ti.types.ndarray(), pcell: ti.types.ndarray(),
             gridp: ti.types.ndarray(), gridn: ti.types.ndarray(), flags: ti.types.ndarray(),
+            wall: ti.types.ndarray(), wid: ti.types.ndarray(), whist: ti.types.ndarray(),
+            wid_old: ti.types.ndarray(), whist_old: ti.types.ndarray(), nwalls: ti.i32,
             skin: ti.f64):
     n = pos.shape[0]
     cap = nbr.shape[1]
@@ -173,6 +179,39 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                     rev[i, b] = rev[i, b - 1]
                     b -= 1
                 rev[i, b] = v
+    # 7. candidate walls (within R + skin), sorted by wall index, history carried over
+    for i in range(n):
+        if flags[F_REBUILD] != 0:
+            capw = wid.shape[1]
+            for s in range(capw):
+                wid_old[i, s] = wid[i, s]
+                whist_old[i, s] = whist[i, s]
+            xi = pos[i]
+            cut = prop[i][0] + skin
+            cnt = 0
+            for w in range(nwalls):
+                a = ti.Vector([wall[w, 0], wall[w, 1]])
+                b = ti.Vector([wall[w, 2], wall[w, 3]])
+                ab = b - a
+                sp = ti.math.clamp((xi - a).dot(ab) * wall[w, 10], 0.0, 1.0)
+                d = a + sp * ab - xi
+                if d.dot(d) < cut * cut:
+                    if cnt < capw:
+                        h = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                        for s in range(capw):
+                            if wid_old[i, s] == w:
+                                h = whist_old[i, s]
+                        wid[i, cnt] = w
+                        whist[i, cnt] = h
+                    cnt += 1
+            ti.atomic_max(flags[F_WALL_NEED], cnt)
+            for s in range(cnt, capw):
+                wid[i, s] = -1
+                whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+    ti.loop_config(serialize=True)
+    for w in range(nwalls):
+        if flags[F_REBUILD] != 0:
+            wall[w, 11] = 0.0
     ti.loop_config(serialize=True)
     for _ in range(1):
         if flags[F_REBUILD] != 0:

@@ -37,10 +37,10 @@ _PARTICLE = {
 _SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
           "nbr_old": "i", "hist_old": 4}
 _COUNTS = ("ncnt", "rcnt", "ncnt_old")
-_WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3}
+_WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3, "wid_old": "i", "whist_old": 4}
 # arrays rebuilt from scratch whenever needed (never saved or restored)
 _SCRATCH = ("cell_count", "cell_start", "sorted", "pcell", "bounds", "nbr_old", "hist_old",
-            "ncnt_old", "simp", "lawp", "lawpair", "facc")
+            "ncnt_old", "simp", "lawp", "lawpair", "facc", "wid_old", "whist_old")
 
 
 def _as_xy(name, value, n=None):
@@ -578,6 +578,7 @@ class Simulation:
         full[:len(rows)] = rows
         self._a["wall"].from_numpy(full)
         self._walls_host = list(rows)
+        self._a["flags"][F_REBUILD] = 1
 
     def _wall_loads(self):
         if not self._built:
@@ -669,7 +670,8 @@ class Simulation:
         return (a["pos"], a["prop"], a["xref"], a["nbr"], a["ncnt"], a["hist"], a["nbr_old"],
                 a["ncnt_old"], a["hist_old"], a["rev"], a["rcnt"], a["cell_count"],
                 a["cell_start"], a["sorted"], a["pcell"], a["gridp"], a["gridn"], a["flags"],
-                float(self.skin))
+                a["wall"], a["wid"], a["whist"], a["wid_old"], a["whist_old"],
+                len(self._walls_host), float(self.skin))
 
     def _one_step(self, step_args, rebuild_args, on_cpu, detail):
         if self._fix_fn:

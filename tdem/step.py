@@ -16,13 +16,14 @@ import taichi as ti
 from physics.contact_law import pair_force, elastic_energy
 from physics.rolling import rolling_couple
 
-from .neighbors import F_BAD, F_REBUILD, F_WALL_NEED, slot_bits
+from .neighbors import F_BAD, F_REBUILD, slot_bits
 
 # columns of the float parameter array ``simp``
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
 SIMP_SIZE = 8
 # columns of the wall array: p0, p1, translation velocity, angular velocity, centre, law
-W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW, W_INVLL = range(11)
+# W_INVLL = 1/|p1 − p0|²; W_DISP = largest displacement of the wall since the lists were built
+W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW, W_INVLL, W_DISP = range(12)
 WALL_WIDTH = 12
 # fixed-velocity bits
 FIX_VX, FIX_VY, FIX_W = 1, 2, 4
@@ -101,85 +102,63 @@ def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.templat
 def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
                   prop: ti.template(), wall: ti.template(), wforce: ti.template(),
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
-                  wcn: ti.template(), wcf: ti.template(), wcs: ti.template(),
-                  flags: ti.template(), nw, dt):
-    """Contacts of particle i with every wall (the wall is 'j', of infinite radius and
-    mass); returns (force on i, moment on i, dissipation, work done by the walls)."""
-    capw = wid.shape[1]
+                  wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt):
+    """Contacts of particle i with its candidate walls (listed in its wall slots by the
+    neighbour build). The wall is 'j', of infinite radius and mass. Returns
+    (force on i, moment on i, dissipation, work done by the walls)."""
     xi = pos[i]
     ri = prop[i][0]
     diss = 0.0
     work = 0.0
     ftot = ti.Vector([0.0, 0.0])
     mtot = 0.0
-    touching = 0
-    held = 0
-    for kk in range(capw):
-        if wid[i, kk] >= 0:
-            held += 1
-    for w in range(nw):
+    for s in range(wid.shape[1]):
+        w = wid[i, s]
+        if w < 0:
+            break
         a = ti.Vector([wall[w, W_X0], wall[w, W_Y0]])
         b = ti.Vector([wall[w, W_X1], wall[w, W_Y1]])
-        q = closest_on_segment(xi, a, b, wall[w, W_INVLL])
-        d = q - xi
+        d = closest_on_segment(xi, a, b, wall[w, W_INVLL]) - xi
         d2 = d.dot(d)
-        if held == 0 and d2 >= ri * ri:
-            continue
-        dist = ti.sqrt(d2)
-        u = ri - dist
-        s = -1
-        for kk in range(capw):
-            if wid[i, kk] == w:
-                s = kk
-        if u > 0.0:
-            touching += 1
-            if s < 0:
-                for kk in range(capw):
-                    if s < 0 and wid[i, kk] < 0:
-                        s = kk
-                if s >= 0:
-                    wid[i, s] = w
-                    whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
-            if s >= 0:
-                n = ti.Vector([1.0, 0.0])
-                if dist > 0.0:
-                    n = d / dist
-                t = perp(n)
-                ai = ri - 0.5 * u
-                xc = xi + ai * n
-                c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
-                ww = wall[w, W_OMEGA]
-                vw = ti.Vector([wall[w, W_VX], wall[w, W_VY]]) + ww * perp(xc - c)
-                vrel = vw - vel[i] - omega[i] * ai * t
-                vn = vrel.dot(n)
-                vs = vrel.dot(t)
-                L = ti.cast(wall[w, W_LAW], ti.i32)
-                h = whist[i, s]
-                fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
-                    lawp, L, u, vn, vs, prop[i][1], ri, dt, h[0])
-                m, m_tot, th, brk, d2 = rolling_couple(
-                    lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[1], h[2], h[3])
-                f = -fn * n + fs_tot * t
-                mi = ai * fs_tot + m_tot
-                whist[i, s] = ti.Vector([fs, m, th, brk])
-                wcn[i, s] = n
-                wcf[i, s] = ti.Vector([f[0], f[1], mi, 0.0])
-                wcs[i, s] = ti.Vector([fn, fs_tot, u])
-                diss += d1 + d2
-                work += f.dot(vw) * dt
-                ftot += f
-                mtot += mi
-                r = xc - c
-                ti.atomic_add(wforce[w][0], -f[0])
-                ti.atomic_add(wforce[w][1], -f[1])
-                ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
-        elif s >= 0:
-            wid[i, s] = -1
+        if d2 < ri * ri:
+            dist = ti.sqrt(d2)
+            u = ri - dist
+            n = ti.Vector([1.0, 0.0])
+            if dist > 0.0:
+                n = d / dist
+            t = perp(n)
+            ai = ri - 0.5 * u
+            xc = xi + ai * n
+            c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
+            ww = wall[w, W_OMEGA]
+            vw = ti.Vector([wall[w, W_VX], wall[w, W_VY]]) + ww * perp(xc - c)
+            vrel = vw - vel[i] - omega[i] * ai * t
+            vn = vrel.dot(n)
+            vs = vrel.dot(t)
+            L = ti.cast(wall[w, W_LAW], ti.i32)
+            h = whist[i, s]
+            fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
+                lawp, L, u, vn, vs, prop[i][1], ri, dt, h[0])
+            m, m_tot, th, brk, d2r = rolling_couple(
+                lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[1], h[2], h[3])
+            f = -fn * n + fs_tot * t
+            mi = ai * fs_tot + m_tot
+            whist[i, s] = ti.Vector([fs, m, th, brk])
+            wcn[i, s] = n
+            wcf[i, s] = ti.Vector([f[0], f[1], mi, 0.0])
+            wcs[i, s] = ti.Vector([fn, fs_tot, u])
+            diss += d1 + d2r
+            work += f.dot(vw) * dt
+            ftot += f
+            mtot += mi
+            r = xc - c
+            ti.atomic_add(wforce[w][0], -f[0])
+            ti.atomic_add(wforce[w][1], -f[1])
+            ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
+        elif whist[i, s][0] != 0.0 or wcs[i, s][2] > 0.0 or whist[i, s][1] != 0.0:
             whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
-            wcs[i, s] = ti.Vector([0.0, 0.0, 0.0])
-    if touching > capw:
-        ti.atomic_max(flags[F_WALL_NEED], touching)
+            wcs[i, s] = ti.Vector([0.0, 0.0, ri - ti.sqrt(d2)])
     return ftot, mtot, diss, work
 
 
@@ -228,7 +207,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             tq += mk
             diss += dk
         fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
-                                         whist, wcn, wcf, wcs, flags, nw, dt)
+                                         whist, wcn, wcf, wcs, dt)
         facc[i] = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw, diss + dw, work])
 
     # 2. gather the partners' share, damp, integrate (leapfrog), skin check
@@ -291,12 +270,18 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         if dx.dot(dx) > half_skin2:
             flags[F_REBUILD] = 1
 
-    # 3. walls move: rotation about their centre, then translation
+    # 3. walls move: rotation about their centre, then translation; a wall that has
+    #    moved half the skin since the lists were built asks for a rebuild
     ti.loop_config(serialize=True)
     for w in range(nw):
         c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
         v = ti.Vector([wall[w, W_VX], wall[w, W_VY]])
         ang = wall[w, W_OMEGA] * dt
+        arm = ti.max((ti.Vector([wall[w, W_X0], wall[w, W_Y0]]) - c).norm(),
+                     (ti.Vector([wall[w, W_X1], wall[w, W_Y1]]) - c).norm())
+        wall[w, W_DISP] += (v.norm() + ti.abs(wall[w, W_OMEGA]) * arm) * dt
+        if wall[w, W_DISP] > 0.5 * simp[P_SKIN]:
+            flags[F_REBUILD] = 1
         rot = ti.Matrix([[ti.cos(ang), -ti.sin(ang)], [ti.sin(ang), ti.cos(ang)]])
         p0 = c + v * dt + rot @ (ti.Vector([wall[w, W_X0], wall[w, W_Y0]]) - c)
         p1 = c + v * dt + rot @ (ti.Vector([wall[w, W_X1], wall[w, W_Y1]]) - c)
@@ -386,7 +371,7 @@ def particle_stress(prop: ti.types.ndarray(), nbr: ti.types.ndarray(),
                 # r = −(R_i − u/2) n, f = −f_owner
                 s += (ri - 0.5 * u) * cn[j, k].outer_product(ti.Vector([c[0], c[1]]))
         for q in range(wid.shape[1]):
-            if wid[i, q] >= 0:
+            if wid[i, q] >= 0 and wcs[i, q][2] > 0.0:
                 u = wcs[i, q][2]
                 c = wcf[i, q]
                 s += (ri - 0.5 * u) * wcn[i, q].outer_product(ti.Vector([c[0], c[1]]))

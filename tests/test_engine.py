@@ -76,3 +76,18 @@ def test_lists_rebuilt_only_after_half_skin():
     b0 = sim.neighbour_builds
     sim.run(steps=100)   # the first disc moves 0.1 m: one rebuild per 0.005 m
     assert sim.neighbour_builds - b0 == pytest.approx(100 * 1e-3 / 0.005, abs=1)
+
+
+def test_moving_wall_found_after_travelling_beyond_the_skin():
+    """A wall starting far away (gap >> skin) and moving at v hits a resting disc: the
+    candidate list must pick it up; an elastic hit by an infinite mass gives the disc
+    2 v."""
+    v = -0.5
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.02, skin=0.002)
+    law = tdem.LinearContact(kn=1e5, friction=0.0)
+    sim.add_particles([[0.0, 0.0]], 0.01, density=1000.0, contact=law)
+    sim.add_wall((0.1, -1.0), (0.1, 1.0), contact=law, velocity=(v, 0.0))
+    sim.run(until=0.3)
+    vel = sim.particles.numpy()["velocity"][0]
+    assert vel[0] == pytest.approx(2 * v, rel=0.005)
+    assert sim.neighbour_builds > 10
