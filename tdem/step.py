@@ -43,47 +43,47 @@ def closest_on_segment(x, a, b, inv_ll):
 
 
 @ti.func
-def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.template(),
-                 prop: ti.template(), plaw: ti.template(), lawp: ti.template(),
-                 lawpair: ti.template(), nbr: ti.template(), hist: ti.template(),
-                 cn: ti.template(), cf: ti.template(), cs: ti.template(), dt,
-                 detail: ti.template()):
-    """Contact in slot k of particle i (the owner, i < j).
+def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template(),
+                 omega: ti.template(), prop: ti.template(), plaw: ti.template(),
+                 lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
+                 hist: ti.template(), cn: ti.template(), cf: ti.template(),
+                 cs: ti.template(), dt, detail: ti.template()):
+    """Contact in slot k of particle i (the owner, i < j); xi, vi, wi, ri, mi, li are
+    i's position, velocity, spin, radius, mass and law group.
 
     Updates the history, stores (f_i, M_j) in the slot for j's gather and returns
     (f_i, M_i, dissipated energy). With ``detail`` also stores the normal, the
     scalar forces and the overlap (for output, stress and energy)."""
     j = nbr[i, k]
-    xi = pos[i]
     d = pos[j] - xi
     dist = d.norm()
-    ri = prop[i][0]
-    rj = prop[j][0]
+    pj = prop[j]
+    rj = pj[0]
     u = ri + rj - dist
     f = ti.Vector([0.0, 0.0])
-    mi = 0.0
+    m_on_i = 0.0
     diss = 0.0
     if u > 0.0:
         n = ti.Vector([1.0, 0.0])
         if dist > 0.0:
-            n = d / dist
+            n = d * (1.0 / dist)
         t = perp(n)
         ai = ri - 0.5 * u
         aj = rj - 0.5 * u
-        vrel = vel[j] - vel[i] - (omega[j] * aj + omega[i] * ai) * t
+        wj = omega[j]
+        vrel = vel[j] - vi - (wj * aj + wi * ai) * t
         vn = vrel.dot(n)
         vs = vrel.dot(t)
-        L = lawpair[plaw[i], plaw[j]]
-        m_i = prop[i][1]
-        m_j = prop[j][1]
+        L = lawpair[li, plaw[j]]
+        mj = pj[1]
+        reff = ri * rj / (ri + rj)
         h = hist[i, k]
         fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
-            lawp, L, u, vn, vs, m_i * m_j / (m_i + m_j), ri * rj / (ri + rj), dt, h[0])
+            lawp, L, u, vn, vs, mi * mj / (mi + mj), reff, dt, h[0])
         m, m_tot, th, brk, d2 = rolling_couple(
-            lawp, L, fn_el, kn, cnd, 2.0 * ri * rj / (ri + rj), omega[i] - omega[j], dt,
-            h[1], h[2], h[3])
+            lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[1], h[2], h[3])
         f = -fn * n + fs_tot * t
-        mi = ai * fs_tot + m_tot
+        m_on_i = ai * fs_tot + m_tot
         hist[i, k] = ti.Vector([fs, m, th, brk])
         cf[i, k] = ti.Vector([f[0], f[1], aj * fs_tot - m_tot])
         diss = d1 + d2
@@ -95,7 +95,7 @@ def pair_contact(i, k, pos: ti.template(), vel: ti.template(), omega: ti.templat
         cf[i, k] = ti.Vector([0.0, 0.0, 0.0])
         if ti.static(detail):
             cs[i, k] = ti.Vector([0.0, 0.0, u])
-    return f, mi, diss
+    return f, m_on_i, diss
 
 
 @ti.func
@@ -200,9 +200,14 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         f = ti.Vector([0.0, 0.0])
         tq = 0.0
         diss = 0.0
+        xi = pos[i]
+        vi = vel[i]
+        wi = omega[i]
+        pi = prop[i]
+        li = plaw[i]
         for k in range(ncnt[i]):
-            fk, mk, dk = pair_contact(i, k, pos, vel, omega, prop, plaw, lawp, lawpair, nbr,
-                                      hist, cn, cf, cs, dt, detail)
+            fk, mk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel, omega, prop,
+                                      plaw, lawp, lawpair, nbr, hist, cn, cf, cs, dt, detail)
             f += fk
             tq += mk
             diss += dk
