@@ -217,7 +217,6 @@ class Simulation:
         self._monitors = []
         self._output = None
         self._fix_fn = None
-        self._last_good = None
         self._crit_cache = None
         self._last_fit = 0
         self._next_event = 1 << 62
@@ -225,6 +224,7 @@ class Simulation:
             self._dt_user = self._check_dt_value(dt)
         self.particles = _View(self._particles_numpy, lambda: self._n)
         self.contacts = _View(self._contacts_numpy, lambda: len(self._contacts_numpy()["pairs"]))
+        self.elements = _View(self._elements_numpy, lambda: 0)
 
     # ------------------------------------------------------------------ set-up
     def _law_id(self, law, argname="contact"):
@@ -914,6 +914,11 @@ class Simulation:
             "overlap": np.concatenate([u, wu]),
             "point": np.concatenate([pts, pos[wi] + (r[wi] - 0.5 * wu)[:, None] * wn]),
         }
+
+    def _elements_numpy(self):
+        """Continuum elements (PCMM): none in a model of plain DEM discs."""
+        return {"triangles": np.zeros((0, 3), np.int64), "weight": np.zeros(0),
+                "stress": np.zeros((0, 2, 2))}
 
     def energy(self):
         """Energy account (J per metre of thickness) at the last completed step:
