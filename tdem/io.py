@@ -1,4 +1,26 @@
-"""Output: monitors (histories), VTU snapshots and series, HDF5, plots."""
+"""Output: monitors (histories), VTU snapshots and series, HDF5 histories, plots.
+
+Conventions of the files written here (SI units throughout):
+
+- VTU files are written with meshio (zlib-compressed binary). Points carry z = 0;
+  vectors are written with three components (z = 0) and the particle stress as a
+  nine-component tensor (row-major 3×3, σ_zz in the last slot), so that ParaView
+  shows them as vectors and tensors.
+- A snapshot is three files: particles (``vertex`` cells), walls (``line`` cells,
+  one per wall) and contacts (``line`` cells, one per contact in force). A file with
+  no walls or no contacts is still written, with zero points and zero cells; VTK
+  and ParaView read it (meshio's own reader does not accept empty cell blocks).
+- A series (:class:`Output`) lists its snapshots in ``particles.pvd``,
+  ``walls.pvd`` and ``contacts.pvd`` with the simulated time of each.
+- ``monitors.h5`` holds one group per monitor with datasets ``time`` (s),
+  ``step`` and ``value`` (one row per record).
+"""
+import math
+import os
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
 import numpy as np
 
 from .errors import InputError
@@ -36,3 +58,425 @@ class Monitor:
 
     def arrays(self):
         return np.array(self.times), (np.array(self.values) if self.values else np.zeros(0))
+
+
+# ------------------------------------------------------------------ VTU files
+def _xyz(a):
+    """(N, 2) → (N, 3) float64 with z = 0."""
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 2)
+    return np.concatenate([a, np.zeros((len(a), 1))], axis=1)
+
+
+def _write_mesh(path, points, cells, point_data=None, cell_data=None):
+    import meshio
+    mesh = meshio.Mesh(points, cells, point_data=point_data or {}, cell_data=cell_data or {})
+    mesh.write(str(path), file_format="vtu")
+
+
+def write_particles_vtu(sim, path, particles=None):
+    """Particles of ``sim`` to ``path``: one ``vertex`` cell per disc.
+
+    Point data: ``id``, ``radius`` (m), ``mass`` (kg per metre of thickness),
+    ``velocity`` (m/s), ``omega`` (rad/s, counter-clockwise positive), ``force`` (N,
+    the contact force of the last step), ``torque`` (N·m), ``displacement`` (m, from
+    the position at insertion), ``stress`` (Pa, tension-positive average stress of
+    the disc, 3×3 row-major with σ_zz last) and ``pressure`` (Pa). ``particles``:
+    ``sim.particles.numpy()`` if the caller has it already.
+    """
+    p = sim.particles.numpy() if particles is None else particles
+    n = len(p["radius"])
+    st = np.zeros((n, 3, 3))
+    st[:, :2, :2] = p["stress"]
+    st[:, 2, 2] = p["stress_zz"]
+    point_data = {
+        "id": np.arange(n, dtype=np.int64),
+        "radius": np.asarray(p["radius"], dtype=np.float64),
+        "mass": np.asarray(p["mass"], dtype=np.float64),
+        "velocity": _xyz(p["velocity"]),
+        "omega": np.asarray(p["omega"], dtype=np.float64),
+        "force": _xyz(p["force"]),
+        "torque": np.asarray(p["torque"], dtype=np.float64),
+        "displacement": _xyz(p["displacement"]),
+        "stress": st.reshape(n, 9),
+        "pressure": np.asarray(p["pressure"], dtype=np.float64),
+    }
+    _write_mesh(path, _xyz(p["position"]), [("vertex", np.arange(n, dtype=np.int64)[:, None])],
+                point_data=point_data)
+    return path
+
+
+def write_walls_vtu(sim, path):
+    """Walls of ``sim`` to ``path``: one ``line`` cell per wall (points p0, p1).
+
+    Cell data: ``id`` (wall index), ``force`` (N, the total contact force the wall
+    received in the last step, z = 0), ``moment`` (N·m about the wall's centre) and
+    ``velocity`` (m/s, translation).
+    """
+    walls = sim.walls
+    pts = np.concatenate([w.endpoints for w in walls]) if walls else np.zeros((0, 2))
+    lines = np.arange(2 * len(walls), dtype=np.int64).reshape(-1, 2)
+    force = np.array([w.force for w in walls]).reshape(-1, 2)
+    cell_data = {
+        "id": [np.arange(len(walls), dtype=np.int64)],
+        "force": [_xyz(force)],
+        "moment": [np.array([w.moment for w in walls], dtype=np.float64)],
+        "velocity": [_xyz(np.array([w.velocity for w in walls]).reshape(-1, 2))],
+    }
+    _write_mesh(path, _xyz(pts), [("line", lines)], cell_data=cell_data)
+    return path
+
+
+def write_contacts_vtu(sim, path, particles=None):
+    """Contacts in force to ``path``: one ``line`` cell per contact, from the centre
+    of particle i to the centre of particle j, or, for a wall contact, to the contact
+    point on the wall. Each contact has its own two points.
+
+    Cell data: ``pair`` (i, j; j = −1 − wall index for a wall), ``normal_force`` (N,
+    compression-positive), ``shear_force`` (N), ``moment`` (N·m, rolling couple),
+    ``overlap`` (m) and ``direction`` (unit normal from i towards j, z = 0). The
+    normal force is also point data (both ends of a line carry the value of their
+    contact), for a *Tube* filter with radius varying by scalar. ``particles``:
+    ``sim.particles.numpy()`` if the caller has it already.
+    """
+    c = sim.contacts.numpy()
+    p = sim.particles.numpy() if particles is None else particles
+    pos = np.asarray(p["position"], dtype=np.float64).reshape(-1, 2)
+    pairs = np.asarray(c["pairs"], dtype=np.int64).reshape(-1, 2)
+    m = len(pairs)
+    a = pos[pairs[:, 0]] if m else np.zeros((0, 2))
+    b = np.zeros((m, 2))
+    to_particle = pairs[:, 1] >= 0
+    b[to_particle] = pos[pairs[to_particle, 1]]
+    b[~to_particle] = np.asarray(c["point"]).reshape(-1, 2)[~to_particle]
+    pts = np.empty((2 * m, 2))
+    pts[0::2] = a
+    pts[1::2] = b
+    fn = np.asarray(c["normal"], dtype=np.float64)
+    cell_data = {
+        "pair": [pairs],
+        "normal_force": [fn],
+        "shear_force": [np.asarray(c["shear"], dtype=np.float64)],
+        "moment": [np.asarray(c["moment"], dtype=np.float64)],
+        "overlap": [np.asarray(c["overlap"], dtype=np.float64)],
+        "direction": [_xyz(c["direction"])],
+    }
+    _write_mesh(path, _xyz(pts), [("line", np.arange(2 * m, dtype=np.int64).reshape(-1, 2))],
+                point_data={"normal_force": np.repeat(fn, 2)}, cell_data=cell_data)
+    return path
+
+
+def write_vtu(sim, path, walls=True, contacts=True):
+    """Write one snapshot of ``sim``: particles to ``path``, and beside it the walls
+    to ``<stem>_walls.vtu`` and the contacts to ``<stem>_contacts.vtu`` (see
+    :func:`write_particles_vtu`, :func:`write_walls_vtu`, :func:`write_contacts_vtu`
+    for the fields). Files of zero walls or zero contacts are written empty.
+
+    Returns the list of paths written (strings), particles first.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    p = sim.particles.numpy()
+    written = [str(write_particles_vtu(sim, path, p))]
+    if walls:
+        written.append(str(write_walls_vtu(sim, path.with_name(path.stem + "_walls.vtu"))))
+    if contacts:
+        written.append(str(write_contacts_vtu(sim, path.with_name(path.stem + "_contacts.vtu"),
+                                              p)))
+    return written
+
+
+def write_pvd(path, entries):
+    """A ParaView collection file: ``entries`` is a list of (time in s, file name
+    relative to the ``.pvd``). Written to a temporary file and moved into place, so
+    that a reader never sees a half-written index."""
+    root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
+    coll = ET.SubElement(root, "Collection")
+    for t, name in entries:
+        ET.SubElement(coll, "DataSet", timestep=repr(float(t)), group="", part="0",
+                      file=str(name))
+    ET.indent(root)
+    tmp = Path(str(path) + ".tmp")
+    ET.ElementTree(root).write(tmp, encoding="utf-8", xml_declaration=True)
+    os.replace(tmp, path)
+    return path
+
+
+# ------------------------------------------------------------------ HDF5 histories
+def _h5_name(name):
+    """An HDF5 group name for a monitor name ('/' separates groups in HDF5)."""
+    name = str(name).replace("/", "_")
+    return "_" if name in ("", ".") else name
+
+
+def write_monitors(sim, path):
+    """Write every monitor of ``sim`` to the HDF5 file ``path``.
+
+    One group per monitor (its name, '/' replaced by '_'; the original name is the
+    group's ``name`` attribute) with datasets ``time`` (K,) in s, ``step`` (K,) and
+    ``value`` (K, ...) and the attribute ``every`` (steps). File attributes:
+    ``simulation`` (its repr), ``time`` (s), ``steps``, ``dt`` (s), ``n_particles``.
+    """
+    import h5py
+    path = Path(path)
+    tmp = Path(str(path) + ".tmp")
+    with h5py.File(tmp, "w") as f:
+        f.attrs["simulation"] = repr(sim)
+        f.attrs["time"] = float(sim.time)
+        f.attrs["steps"] = int(sim.steps)
+        f.attrs["n_particles"] = int(getattr(sim, "n_particles", 0))
+        try:
+            f.attrs["dt"] = float(sim.dt)
+        except (InputError, ValueError):
+            pass
+        for m in getattr(sim, "_monitors", []):
+            g = f.create_group(_h5_name(m.name))
+            g.attrs["name"] = m.name
+            g.attrs["every"] = int(m.every)
+            t, v = m.arrays()
+            g.create_dataset("time", data=np.asarray(t, dtype=np.float64))
+            g.create_dataset("step", data=np.asarray(m.steps, dtype=np.int64))
+            g.create_dataset("value", data=np.asarray(v, dtype=np.float64))
+    os.replace(tmp, path)
+    return path
+
+
+def read_monitors(path):
+    """{monitor name: (time (K,), value (K, ...))} from a file of :func:`write_monitors`."""
+    import h5py
+    out = {}
+    with h5py.File(path, "r") as f:
+        for key, g in f.items():
+            if not isinstance(g, h5py.Group) or "time" not in g or "value" not in g:
+                continue
+            name = g.attrs.get("name", key)
+            out[str(name)] = (g["time"][()], g["value"][()])
+    return out
+
+
+# ------------------------------------------------------------------ series
+class Output:
+    """A VTU series with ``.pvd`` indices, monitor histories and abort checkpoints.
+
+    Created by :meth:`tdem.Simulation.output`. Snapshots are written every ``every``
+    steps, or every ``interval`` seconds of simulated time (at the first step at or
+    after each multiple of ``interval`` from the time output was set up), or, with
+    neither, only at the end of each run. The state when output is set up is the
+    first snapshot. Files in ``directory``: ``particles_KKKKK.vtu``,
+    ``walls_KKKKK.vtu``, ``contacts_KKKKK.vtu`` (K: snapshot number), the indices
+    ``particles.pvd``, ``walls.pvd``, ``contacts.pvd``, ``monitors.h5`` (at the end of
+    each run) and, after an interrupted or unstable run, ``last_good.h5`` (a
+    checkpoint of the last good state, see :func:`tdem.checkpoint.load`).
+
+    The engine calls :meth:`next_step`, :meth:`write`, :meth:`truncate`,
+    :meth:`flush` and :meth:`abort`.
+    """
+
+    def __init__(self, directory, every=None, interval=None, contacts=True, walls=True,
+                 checkpoint_on_abort=True, sim=None):
+        if every is not None and interval is not None:
+            raise InputError(f"give at most one of every= and interval=, got every={every!r}, "
+                             f"interval={interval!r}")
+        if every is not None:
+            try:
+                ok = int(every) == every and every >= 1
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise InputError(f"every must be a whole number of steps >= 1, got {every!r}")
+            every = int(every)
+        if interval is not None:
+            try:
+                ok = float(interval) > 0 and math.isfinite(float(interval))
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise InputError(f"interval must be a positive time in seconds, got {interval!r}")
+            interval = float(interval)
+        self.directory = Path(directory)
+        self.directory.mkdir(parents=True, exist_ok=True)
+        self.every = every
+        self.interval = interval
+        self.contacts = bool(contacts)
+        self.walls = bool(walls)
+        self.checkpoint_on_abort = bool(checkpoint_on_abort)
+        self._sim = sim
+        self._entries = []          # (step, time, snapshot number), in step order
+        self._start = (0, 0.0) if sim is None else (int(sim.steps), float(sim.time))
+        self._initial_due = sim is not None
+        if sim is not None and getattr(sim, "n_particles", 0) > 0:
+            self._write_initial(sim)
+
+    # ---------------------------------------------------------------- paths
+    def _names(self, k):
+        names = {"particles": f"particles_{k:05d}.vtu"}
+        if self.walls:
+            names["walls"] = f"walls_{k:05d}.vtu"
+        if self.contacts:
+            names["contacts"] = f"contacts_{k:05d}.vtu"
+        return names
+
+    @property
+    def pvd_paths(self):
+        """The ``.pvd`` index files of the series."""
+        return [self.directory / f"{kind}.pvd" for kind in self._names(0)]
+
+    @property
+    def snapshots(self):
+        """[(step, time in s)] of the snapshots listed in the series."""
+        return [(s, t) for s, t, _ in self._entries]
+
+    # ---------------------------------------------------------- engine calls
+    def _write_initial(self, sim):
+        self._initial_due = False
+        self._start = (int(sim.steps), float(sim.time))
+        self.write(sim)
+
+    def next_step(self, sim):
+        """The step at which the next snapshot is due (a very large number when none
+        is). If output was set up before the simulation had particles, the initial
+        snapshot is written here, at the start of the first run."""
+        if self._initial_due and getattr(sim, "_built", True) and sim.n_particles > 0:
+            self._write_initial(sim)
+        if self.every is not None:
+            last = self._entries[-1][0] if self._entries else self._start[0]
+            return last + self.every
+        if self.interval is not None:
+            last_step, last_time = ((self._entries[-1][0], self._entries[-1][1])
+                                    if self._entries else self._start)
+            t0 = self._start[1]
+            k = math.floor((last_time - t0) / self.interval + 1e-9) + 1
+            target = t0 + k * self.interval
+            dt = float(sim.dt)
+            return last_step + max(1, int(math.ceil((target - last_time) / dt - 1e-9)))
+        return 1 << 62
+
+    def write(self, sim):
+        """Write a snapshot of the current state and rewrite the ``.pvd`` indices.
+        Returns the paths of the files written."""
+        step, t = int(sim.steps), float(sim.time)
+        if self._entries and self._entries[-1][0] == step:
+            k = self._entries.pop()[2]
+        else:
+            k = self._entries[-1][2] + 1 if self._entries else 0
+        names = self._names(k)
+        p = sim.particles.numpy()
+        written = [str(write_particles_vtu(sim, self.directory / names["particles"], p))]
+        if self.walls:
+            written.append(str(write_walls_vtu(sim, self.directory / names["walls"])))
+        if self.contacts:
+            written.append(str(write_contacts_vtu(sim, self.directory / names["contacts"], p)))
+        self._entries.append((step, t, k))
+        self._write_indices()
+        return written
+
+    def _write_indices(self):
+        for kind in self._names(0):
+            write_pvd(self.directory / f"{kind}.pvd",
+                      [(t, self._names(k)[kind]) for _, t, k in self._entries])
+
+    def truncate(self, step):
+        """The run was rewound to ``step``: forget (and delete) the snapshots written
+        after it."""
+        dropped = [e for e in self._entries if e[0] > step]
+        if not dropped:
+            return
+        self._entries = [e for e in self._entries if e[0] <= step]
+        for _, _, k in dropped:
+            for name in self._names(k).values():
+                try:
+                    os.remove(self.directory / name)
+                except FileNotFoundError:
+                    pass
+        self._write_indices()
+
+    def flush(self, sim=None):
+        """End of a run: write ``monitors.h5``; with neither ``every`` nor ``interval``
+        also a snapshot of the current state."""
+        sim = sim if sim is not None else self._sim
+        if sim is None:
+            return
+        if self.every is None and self.interval is None and sim.n_particles > 0 and \
+                not (self._entries and self._entries[-1][0] == sim.steps):
+            self.write(sim)
+        write_monitors(sim, self.directory / "monitors.h5")
+
+    def abort(self, sim, why):
+        """The run stopped early (``why``: "interrupted" or "unstable") with the last
+        good state in ``sim``: write ``monitors.h5`` and, if ``checkpoint_on_abort``,
+        ``last_good.h5`` (its attribute ``abort_reason`` says why). Errors while
+        writing are turned into warnings, so that the original error propagates."""
+        try:
+            write_monitors(sim, self.directory / "monitors.h5")
+        except Exception as e:  # noqa: BLE001 - must not hide the run's own error
+            warnings.warn(f"could not write monitors.h5 after the run stopped: {e!r}")
+        if not self.checkpoint_on_abort:
+            return
+        path = self.directory / "last_good.h5"
+        try:
+            sim.save(path)
+            import h5py
+            with h5py.File(path, "a") as f:
+                f.attrs["abort_reason"] = str(why)
+        except Exception as e:  # noqa: BLE001
+            warnings.warn(f"could not write the checkpoint {path} after the run stopped: {e!r}")
+
+    def close(self, sim=None):
+        """Write ``monitors.h5`` now (for the simulation output was set up with)."""
+        self.flush(sim)
+
+    def __repr__(self):
+        mode = (f"every={self.every}" if self.every is not None else
+                f"interval={self.interval}" if self.interval is not None else "end of runs")
+        return f"Output({str(self.directory)!r}, {mode}, {len(self._entries)} snapshots)"
+
+
+# ------------------------------------------------------------------ plots
+def plot_histories(source, png_path, names=None, title=None):
+    """PNG of monitor histories, one panel per monitor, time (s) on the x axis.
+
+    ``source``: a Simulation (its :meth:`~tdem.Simulation.histories`), the path of a
+    ``monitors.h5`` file, or a dict {name: (times, values)}. ``names`` selects and
+    orders the monitors (default: all). Vector-valued monitors get one line per
+    component. Returns ``png_path``.
+    """
+    from matplotlib.figure import Figure
+
+    if hasattr(source, "histories"):
+        hist = source.histories()
+    elif isinstance(source, dict):
+        hist = source
+    else:
+        hist = read_monitors(source)
+    if names is None:
+        names = list(hist)
+    else:
+        missing = [n for n in names if n not in hist]
+        if missing:
+            raise InputError(f"names: no monitor called {missing[0]!r}; there are "
+                             f"{sorted(hist)}")
+    rows = max(len(names), 1)
+    fig = Figure(figsize=(7.0, 1.0 + 2.2 * rows))
+    axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
+    for ax, name in zip(axes, names):
+        t, v = hist[name]
+        t = np.asarray(t, dtype=float)
+        v = np.asarray(v, dtype=float).reshape(len(t), -1) if len(t) else np.zeros((0, 1))
+        if v.shape[1] == 1:
+            ax.plot(t, v[:, 0], lw=1.2)
+        else:
+            for c in range(v.shape[1]):
+                ax.plot(t, v[:, c], lw=1.2, label=f"[{c}]")
+            ax.legend(fontsize="small", loc="best")
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+    if not names:
+        axes[0].text(0.5, 0.5, "no monitors", ha="center", va="center",
+                     transform=axes[0].transAxes)
+    axes[-1].set_xlabel("time (s)")
+    if title:
+        axes[0].set_title(title)
+    fig.tight_layout()
+    png_path = str(png_path)
+    Path(png_path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(png_path, dpi=120, format="png")
+    return png_path

@@ -523,6 +523,7 @@ class Simulation:
             if k in self._a:
                 self._fill(k, v)
         self._built = True
+        self._a["facc"].from_numpy(np.zeros((n, 5)))  # sums start from zero every step
         self._upload_laws()
         self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.WALL_WIDTH), fresh=True)
         self._fit_grid(force=True)

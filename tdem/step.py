@@ -1,8 +1,9 @@
 """One time step of the DEM: the whole data flow in one kernel.
 
     forces at x_n (pair contacts from the neighbour lists, wall contacts),
-      summed per owner particle; each pair slot keeps the partner's share
-      -> gather per particle (own sum + reverse slots, no atomics)
+      summed per owner particle; the partner's share goes straight to its sum on
+      one thread, or stays in the pair's slot when threads run in parallel
+      -> gather per particle (own sum + reverse slots: no atomics, fixed order)
       -> damping, prescribed velocities, leapfrog: v_{n+1/2}, x_{n+1}
       -> energy account at t_n, skin check (raises the rebuild flag)
       -> walls move
@@ -46,14 +47,14 @@ def closest_on_segment(x, a, b, inv_ll):
 def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template(),
                  omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                  lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
-                 hist: ti.template(), cn: ti.template(), cf: ti.template(),
-                 cs: ti.template(), dt, detail: ti.template()):
+                 hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
+                 detail: ti.template()):
     """Contact in slot k of particle i (the owner, i < j); xi, vi, wi, ri, mi, li are
     i's position, velocity, spin, radius, mass and law group.
 
-    Updates the history, stores (f_i, M_j) in the slot for j's gather and returns
-    (f_i, M_i, dissipated energy). With ``detail`` also stores the normal, the
-    scalar forces and the overlap (for output, stress and energy)."""
+    Updates the history and returns (f_i, M_i, M_j, dissipated energy). With
+    ``detail`` also stores the normal, the scalar forces and the overlap (for
+    output, stress and energy)."""
     j = nbr[i, k]
     d = pos[j] - xi
     dist = d.norm()
@@ -62,6 +63,7 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     u = ri + rj - dist
     f = ti.Vector([0.0, 0.0])
     m_on_i = 0.0
+    m_on_j = 0.0
     diss = 0.0
     if u > 0.0:
         n = ti.Vector([1.0, 0.0])
@@ -84,18 +86,17 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
             lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[1], h[2], h[3])
         f = -fn * n + fs_tot * t
         m_on_i = ai * fs_tot + m_tot
+        m_on_j = aj * fs_tot - m_tot
         hist[i, k] = ti.Vector([fs, m, th, brk])
-        cf[i, k] = ti.Vector([f[0], f[1], aj * fs_tot - m_tot])
         diss = d1 + d2
         if ti.static(detail):
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, fs_tot, u])
     else:
         hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
-        cf[i, k] = ti.Vector([0.0, 0.0, 0.0])
         if ti.static(detail):
             cs[i, k] = ti.Vector([0.0, 0.0, u])
-    return f, m_on_i, diss
+    return f, m_on_i, m_on_j, diss
 
 
 @ti.func
@@ -194,7 +195,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     for w in range(nw):
         wforce[w] = ti.Vector([0.0, 0.0, 0.0])
 
-    # 1. contact forces at x_n: each pair once, in its owner's slot (owner = lower index)
+    # 1. contact forces at x_n: each pair once, by its owner (the lower index). On one
+    #    thread the partner's share goes straight into its sum; in parallel it is kept
+    #    in the slot and gathered in 2. (no atomics, a fixed summation order).
     ti.loop_config(serialize=serial)
     for i in range(n):
         f = ti.Vector([0.0, 0.0])
@@ -206,14 +209,24 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         pi = prop[i]
         li = plaw[i]
         for k in range(ncnt[i]):
-            fk, mk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel, omega, prop,
-                                      plaw, lawp, lawpair, nbr, hist, cn, cf, cs, dt, detail)
+            fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel, omega,
+                                           prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt,
+                                           detail)
             f += fk
             tq += mk
             diss += dk
+            if ti.static(serial):
+                j = nbr[i, k]
+                facc[j] += ti.Vector([-fk[0], -fk[1], mjk, 0.0, 0.0])
+            if ti.static(detail or not serial):
+                cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
         fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
                                          whist, wcn, wcf, wcs, dt)
-        facc[i] = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw, diss + dw, work])
+        own = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw, diss + dw, work])
+        if ti.static(serial):
+            facc[i] += own
+        else:
+            facc[i] = own
 
     # 2. gather the partners' share, damp, integrate (leapfrog), skin check
     ti.loop_config(serialize=serial)
@@ -221,13 +234,16 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         a = facc[i]
         f = ti.Vector([a[0], a[1]])
         tq = a[2]
-        for r in range(rcnt[i]):
-            flat = rev[i, r]
-            j = flat >> bits
-            k = flat & (cap - 1)
-            c = cf[j, k]
-            f -= ti.Vector([c[0], c[1]])
-            tq += c[2]
+        if ti.static(serial):
+            facc[i] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
+        else:
+            for r in range(rcnt[i]):
+                flat = rev[i, r]
+                j = flat >> bits
+                k = flat & (cap - 1)
+                c = cf[j, k]
+                f -= ti.Vector([c[0], c[1]])
+                tq += c[2]
         m = prop[i][1]
         inertia = prop[i][2]
         v0 = vel[i]

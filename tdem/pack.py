@@ -1,0 +1,293 @@
+"""Particle packings: regular lattices and dense random packings of discs.
+
+Every function returns ``(positions, radii)``: float arrays of shapes (N, 2) and
+(N,). Lengths are in metres.
+
+- :func:`regular`: square lattice of touching discs (spacing 2R).
+- :func:`cross`: hexagonal lattice of touching discs (rows R·√3 apart, every
+  other row shifted by R), the "cross" packing of Feng, Li & Oñate (2015).
+- :func:`random`: dense random packing, radii uniform in [rmin, rmax], in a
+  rectangle or a polygon, by radius expansion with overlap relaxation.
+
+The lattices put the outermost centres ``inset`` from the edges of the rectangle:
+``inset = R`` (the default) keeps every disc inside it; ``inset = 0`` puts centres
+on the edges, as the nodes of a structured mesh (the paper's 100 × 200 mm
+specimens: 861 regular and 964 cross particles of R = 2.5 mm).
+"""
+import math
+
+import numpy as np
+
+from .errors import InputError
+
+# relative slack when counting how many lattice spacings fit in a length
+_FIT_EPS = 1e-9
+
+
+def _positive(name, value):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a positive number, got {value!r}") from None
+    if not (v > 0.0 and math.isfinite(v)):
+        raise InputError(f"{name} must be a positive number, got {value!r}")
+    return v
+
+
+def _origin(origin):
+    try:
+        o = np.asarray(origin, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"origin must be two numbers, got {origin!r}") from None
+    if o.shape != (2,) or not np.all(np.isfinite(o)):
+        raise InputError(f"origin must be two finite numbers, got {origin!r}")
+    return o
+
+
+def _lattice_span(width, height, radius, inset):
+    """The rectangle the centres must lie in, as (usable width, usable height, inset)."""
+    width = _positive("width", width)
+    height = _positive("height", height)
+    radius = _positive("radius", radius)
+    inset = radius if inset is None else float(inset)
+    if not (inset >= 0.0 and math.isfinite(inset)):
+        raise InputError(f"inset must be a number >= 0, got {inset!r}")
+    if width < 2 * inset or height < 2 * inset:
+        raise InputError(f"the rectangle {width} x {height} is smaller than twice the inset "
+                         f"{inset} (width and height must be >= {2 * inset})")
+    return width - 2 * inset, height - 2 * inset, radius, inset
+
+
+def _count(length, spacing):
+    """Number of points spaced ``spacing`` apart in [0, length] starting at 0."""
+    return int(math.floor(length / spacing * (1 + _FIT_EPS) + _FIT_EPS)) + 1
+
+
+def regular(width, height, radius, origin=(0.0, 0.0), inset=None):
+    """Square lattice of touching discs of radius R (centre spacing 2R).
+
+    Centres lie in the rectangle ``origin + [0, width] × [0, height]`` at least
+    ``inset`` (default R) from its edges, starting from its lower-left corner;
+    ordered row by row (x fastest). 20 × 20 m with R = 0.5 m gives 400 discs.
+    """
+    w, h, r, inset = _lattice_span(width, height, radius, inset)
+    o = _origin(origin)
+    nx, ny = _count(w, 2 * r), _count(h, 2 * r)
+    x = o[0] + inset + 2 * r * np.arange(nx)
+    y = o[1] + inset + 2 * r * np.arange(ny)
+    xx, yy = np.meshgrid(x, y)
+    pos = np.stack([xx.ravel(), yy.ravel()], axis=1)
+    return pos, np.full(len(pos), r)
+
+
+def cross(width, height, radius, origin=(0.0, 0.0), inset=None):
+    """Hexagonal lattice of touching discs of radius R.
+
+    Rows run along x, R·√3 apart in y; in-row spacing 2R; odd rows are shifted by
+    R. Centres lie in ``origin + [0, width] × [0, height]`` at least ``inset``
+    (default R) from its edges; ordered row by row (x fastest). Each interior
+    disc touches six others at 60° intervals.
+    """
+    w, h, r, inset = _lattice_span(width, height, radius, inset)
+    o = _origin(origin)
+    dy = r * math.sqrt(3.0)
+    rows = []
+    for k in range(_count(h, dy)):
+        shift = r * (k % 2)
+        if shift > w * (1 + _FIT_EPS):
+            continue
+        n = _count(w - shift, 2 * r)
+        x = o[0] + inset + shift + 2 * r * np.arange(n)
+        rows.append(np.stack([x, np.full(n, o[1] + inset + k * dy)], axis=1))
+    pos = np.concatenate(rows)
+    return pos, np.full(len(pos), r)
+
+
+# ----------------------------------------------------------------- random packing
+def _region(width, height, origin, polygon):
+    """Counter-clockwise vertices (M, 2) of the packing region."""
+    if polygon is None:
+        if width is None or height is None:
+            raise InputError("width and height are required unless polygon is given")
+        w = _positive("width", width)
+        h = _positive("height", height)
+        o = _origin(origin)
+        return o + np.array([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]])
+    if width is not None or height is not None:
+        raise InputError("give either width and height or polygon, not both "
+                         f"(width={width!r}, height={height!r})")
+    try:
+        p = np.asarray(polygon, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"polygon must be an (M, 2) array of vertices, got {polygon!r}") from None
+    if p.ndim != 2 or p.shape[1] != 2 or len(p) < 3 or not np.all(np.isfinite(p)):
+        raise InputError(f"polygon must be an (M, 2) array of M >= 3 finite vertices, "
+                         f"got shape {p.shape}")
+    area2 = np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+    if not area2 != 0.0:
+        raise InputError("polygon has zero area")
+    return p if area2 > 0 else p[::-1].copy()
+
+
+def _polygon_area(p):
+    return 0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+
+
+def _signed_distance(x, poly):
+    """Signed distance of points x (N, 2) to the boundary of the polygon (positive
+    inside) and the unit vector pointing into the polygon at the nearest point."""
+    a = poly
+    b = np.roll(poly, -1, axis=0)
+    ab = b - a                                             # (M, 2)
+    ax = x[:, None, :] - a[None, :, :]                     # (N, M, 2)
+    t = np.clip(np.einsum("nmk,mk->nm", ax, ab) / np.einsum("mk,mk->m", ab, ab), 0.0, 1.0)
+    near = a[None] + t[..., None] * ab[None]               # (N, M, 2)
+    diff = x[:, None, :] - near
+    dist = np.sqrt(np.einsum("nmk,nmk->nm", diff, diff))
+    k = np.argmin(dist, axis=1)
+    idx = np.arange(len(x))
+    d = dist[idx, k]
+    # even-odd rule for the inside test
+    y0, y1 = a[None, :, 1], b[None, :, 1]
+    xs = x[:, 0:1]
+    ys = x[:, 1:2]
+    crosses = (y0 > ys) != (y1 > ys)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xint = a[None, :, 0] + (ys - y0) * (b[None, :, 0] - a[None, :, 0]) / (y1 - y0)
+    inside = (np.sum(crosses & (xs < xint), axis=1) % 2) == 1
+    sign = np.where(inside, 1.0, -1.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = diff[idx, k] / d[:, None]
+    # a point exactly on the boundary: step along the inward edge normal
+    edge = ab[k] / np.linalg.norm(ab[k], axis=1)[:, None]
+    inward_normal = np.stack([-edge[:, 1], edge[:, 0]], axis=1)
+    u = np.where((d > 0)[:, None], u * sign[:, None], inward_normal)
+    return sign * d, u
+
+
+def _pairs(x, cut, h):
+    """All pairs (i < j) closer than ``cut`` (a scalar), by a cell grid of side h >= cut."""
+    lo = x.min(axis=0)
+    c = np.floor((x - lo) / h).astype(np.int64)
+    nx, ny = c.max(axis=0) + 1
+    cell = c[:, 0] * ny + c[:, 1]
+    order = np.argsort(cell, kind="stable")
+    counts = np.bincount(cell, minlength=nx * ny)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    idx_i, idx_j = [], []
+    for ox, oy in ((0, 0), (1, -1), (1, 0), (1, 1), (0, 1)):
+        cx, cy = c[:, 0] + ox, c[:, 1] + oy
+        ok = (cx < nx) & (cy >= 0) & (cy < ny)
+        i = np.nonzero(ok)[0]
+        oc = cx[ok] * ny + cy[ok]
+        m = counts[oc]
+        rep_i = np.repeat(i, m)
+        first = np.repeat(start[oc], m)
+        within = np.arange(len(rep_i)) - np.repeat(np.cumsum(m) - m, m)
+        j = order[first + within]
+        keep = j > rep_i if (ox, oy) == (0, 0) else np.ones(len(j), bool)
+        idx_i.append(rep_i[keep])
+        idx_j.append(j[keep])
+    i = np.concatenate(idx_i)
+    j = np.concatenate(idx_j)
+    d = x[j] - x[i]
+    close = np.einsum("nk,nk->n", d, d) < cut * cut
+    i, j = i[close], j[close]
+    swap = i > j
+    i[swap], j[swap] = j[swap], i[swap]
+    return i, j
+
+
+def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 0.0),
+           polygon=None, overlap_tol=1e-3, max_iter=20000):
+    """Dense random packing of discs with radii uniform in [rmin, rmax].
+
+    The region is the rectangle ``origin + [0, width] × [0, height]``, or the
+    simple polygon ``polygon`` (M, 2) (then width and height must be None). Every
+    disc lies inside the region.
+
+    Radii are drawn until the discs' total area reaches ``target_fraction`` × the
+    region's area (this fixes N). Centres start uniformly at random in the region;
+    the radii are then grown from half their size to full size while overlaps are
+    relaxed (each overlapping pair is pushed apart by half the overlap, each disc
+    pushed back inside the region), and relaxation continues until no overlap
+    (pair or boundary) exceeds ``overlap_tol`` × rmin.
+
+    Deterministic for a given ``seed``. ``target_fraction`` must lie in (0, 0.85]:
+    random packings of these discs jam near 0.84 (less in a small region, where the
+    boundary layer is loose); a fraction that cannot be reached raises
+    :class:`tdem.InputError` after ``max_iter`` relaxation sweeps. A 20 × 20 m
+    square with R = 0.168–0.312 m at 0.8 holds about 1720 discs and takes a few
+    seconds.
+    """
+    rmin = _positive("rmin", rmin)
+    rmax = _positive("rmax", rmax)
+    if rmax < rmin:
+        raise InputError(f"rmax must be >= rmin, got rmin={rmin!r}, rmax={rmax!r}")
+    tf = float(target_fraction)
+    if not (0.0 < tf <= 0.85):
+        raise InputError(f"target_fraction must lie in (0, 0.85], got {target_fraction!r}")
+    poly = _region(width, height, origin, polygon)
+    area = _polygon_area(poly)
+    bb_lo, bb_hi = poly.min(axis=0), poly.max(axis=0)
+    if np.min(bb_hi - bb_lo) < 2 * rmax:
+        raise InputError(f"the region ({(bb_hi - bb_lo).tolist()} m across) is too small "
+                         f"for discs of rmax={rmax!r}")
+    rng = np.random.default_rng(seed)
+
+    # radii until the target area is reached
+    mean_area = math.pi * (rmin * rmin + rmin * rmax + rmax * rmax) / 3.0
+    est = int(tf * area / mean_area * 1.1) + 16
+    r = rng.uniform(rmin, rmax, est)
+    while np.sum(np.pi * r * r) < tf * area:
+        r = np.concatenate([r, rng.uniform(rmin, rmax, est)])
+    n = int(np.searchsorted(np.cumsum(np.pi * r * r), tf * area)) + 1
+    r = r[:n]
+
+    # centres uniform in the region (rejection from the bounding box)
+    x = np.zeros((0, 2))
+    while len(x) < n:
+        cand = rng.uniform(bb_lo, bb_hi, (2 * (n - len(x)) + 16, 2))
+        sd, _ = _signed_distance(cand, poly)
+        x = np.concatenate([x, cand[sd > 0]])
+    x = x[:n]
+
+    tol = overlap_tol * rmin
+    skin = 0.5 * rmin
+    h = 2 * rmax + skin
+    scale = 0.5
+    grow = 0.002
+    i = j = None
+    x_ref = None
+    for _ in range(int(max_iter)):
+        if x_ref is None or np.max(np.sum((x - x_ref) ** 2, axis=1)) > (0.5 * skin) ** 2:
+            i, j = _pairs(x, 2 * rmax + skin, h)
+            x_ref = x.copy()
+        rs = scale * r
+        d = x[j] - x[i]
+        dist = np.sqrt(np.einsum("nk,nk->n", d, d))
+        ov = rs[i] + rs[j] - dist
+        hit = ov > 0
+        push = np.zeros((n, 2))
+        worst = 0.0
+        if hit.any():
+            worst = float(ov[hit].max())
+            u = d[hit] / np.maximum(dist[hit], 1e-300)[:, None]
+            s = 0.5 * ov[hit][:, None] * u
+            for k in range(2):
+                push[:, k] -= np.bincount(i[hit], s[:, k], minlength=n)
+                push[:, k] += np.bincount(j[hit], s[:, k], minlength=n)
+        sd, inward = _signed_distance(x, poly)
+        pen = rs - sd
+        out = pen > 0
+        if out.any():
+            worst = max(worst, float(pen[out].max()))
+            push[out] += pen[out][:, None] * inward[out]
+        x = x + push
+        if scale < 1.0:
+            scale = min(1.0, scale + grow)
+        elif worst <= tol:
+            return x, r
+    raise InputError(f"target_fraction={target_fraction!r} could not be reached without "
+                     f"overlaps in {max_iter} sweeps (largest overlap {worst:.3g} m); "
+                     f"lower it")
