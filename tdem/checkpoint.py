@@ -5,8 +5,9 @@ their contact history, wall slots, walls, the cell grid and the status flags) an
 the host-side description the object is rebuilt from (constructor parameters,
 contact laws, groups, walls, prescribed velocities, capacities, clock).
 :func:`load` rebuilds a simulation that continues exactly: the same steps give
-the same numbers, bit for bit, as the run that was saved (the engine's summation
-order does not depend on the number of threads). Wall forces, which are summed
+the same numbers, bit for bit, as the run that was saved, on the same number of
+threads (the engine's summation order is fixed; one thread sums in another order
+than several, which agrees to round-off). Wall forces, which are summed
 with atomic additions, are output only and may differ in the last bits between
 two runs on several threads.
 
