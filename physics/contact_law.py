@@ -85,11 +85,14 @@ def check_friction_cohesion(friction, cohesion, damping_ratio):
 
 
 @ti.func
-def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt):
+def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt, fs_old):
     """Coulomb limit |F_s| <= F_n tan(phi) + c (C&S Eq. 19), keeping the sign.
 
     Returns (spring force kept, total shear force, dissipated energy). The shear
-    dashpot is off while sliding (C&S).
+    dashpot is off while sliding (C&S). The slip energy is the mean of the old and
+    new shear force times the slip increment (F_trial − F_s)/k_s, which is what the
+    central-difference step does on the spring (with F_max alone the account loses
+    an O(Δt) share whenever F_n changes while sliding).
     """
     fmax = ti.max(fn_el * mu + coh, 0.0)
     fs = fs_trial
@@ -99,7 +102,7 @@ def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt):
         fs = ti.math.sign(fs_trial) * fmax
         fs_tot = fs
         if ks > 0.0:
-            diss = fmax * ti.abs(fs_trial - fs) / ks
+            diss = 0.5 * (fs_old + fs) * (fs_trial - fs) / ks
     else:
         fs_tot = fs + cs * vs
         diss = cs * vs * vs * dt
@@ -134,7 +137,7 @@ def pair_force(lawp: ti.template(), L, u, vn, vs, meff, reff, dt, fs_old):
     cs = beta * ks
     fn = fn_el - cn * vn
     fs, fs_tot, diss = coulomb_shear(fs_old + ks * vs * dt, fn_el, lawp[L, 3], lawp[L, 4],
-                                     ks, cs, vs, dt)
+                                     ks, cs, vs, dt, fs_old)
     diss += cn * vn * vn * dt
     return fn_el, fn, fs, fs_tot, kn, cn, diss
 

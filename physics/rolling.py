@@ -55,17 +55,21 @@ def rolling_couple(lawp: ti.template(), L, fn_el, kn, cn, rbar, dw, dt, m_old, t
         km = kn * b * b / 12.0
         m = m_old - km * dw * dt
         limited = False
+        # energy of a plastic or brittle step: mean of the old and new couple times
+        # the plastic rotation (M_trial − M)/K_m; a Model 2 break thus books the
+        # spring's stored energy M²/(2 K_m)
         if model == 1:
             m0 = ti.max(fn_el, 0.0) * b / 6.0
             if ti.abs(m) > m0:
                 mc = ti.math.sign(m) * m0
-                diss += m0 * ti.abs(m - mc) / km
+                diss += 0.5 * (m_old + mc) * (m - mc) / km
                 m = mc
                 limited = True
         else:
             th0 = 2.0 * ti.max(fn_el, 0.0) / (kn * b)
             if brk > 0.5 or ti.abs(th) > th0:
                 brk = 1.0
+                diss += 0.5 * m_old * m / km
                 m = 0.0
                 limited = True
         m_tot = m
