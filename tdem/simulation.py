@@ -39,8 +39,19 @@ _SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
 _COUNTS = ("ncnt", "rcnt", "ncnt_old")
 _WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3, "wid_old": "i", "whist_old": 4}
 # arrays rebuilt from scratch whenever needed (never saved or restored)
-_SCRATCH = ("cell_count", "cell_start", "sorted", "pcell", "bounds", "nbr_old", "hist_old",
+_SCRATCH = ("stress_out", "cell_count", "cell_start", "sorted", "pcell", "bounds", "nbr_old", "hist_old",
             "ncnt_old", "simp", "lawp", "lawpair", "facc", "wid_old", "whist_old")
+
+
+def _vector2(name, value):
+    """One 2-vector (gravity, a velocity, a point)."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be two numbers, got {value!r}") from None
+    if a.shape != (2,) or not np.isfinite(a).all():
+        raise InputError(f"{name} must be two finite numbers (x, y), got {value!r}")
+    return a
 
 
 def _as_xy(name, value, n=None):
@@ -98,7 +109,7 @@ class Wall:
 
     @velocity.setter
     def velocity(self, v):
-        v = _as_xy("velocity", [v])[0]
+        v = _vector2("velocity", v)
         self._set([stepk.W_VX, stepk.W_VY], v)
 
     @property
@@ -144,8 +155,8 @@ class _View:
         self._fn = fn
         self._count = count
 
-    def numpy(self):
-        return self._fn()
+    def numpy(self, **options):
+        return self._fn(**options)
 
     def __len__(self):
         return self._count()
@@ -173,7 +184,7 @@ class Simulation:
     def __init__(self, gravity=(0.0, -9.81), dt=None, dt_fraction=0.2, arch=None,
                  precision="f64", local_damping=0.0, global_damping=0.0, skin=None,
                  check_interval=100, progress=None, threads=None):
-        g = _as_xy("gravity", [gravity])[0]
+        g = _vector2("gravity", gravity)
         if precision not in ("f64", "f32"):
             raise InputError(f"precision must be 'f64' or 'f32', got {precision!r}")
         dt_fraction = float(dt_fraction)
@@ -255,16 +266,16 @@ class Simulation:
         bad = ~(np.isfinite(r) & (r > 0))
         if bad.any():
             k = int(np.argmax(bad))
-            raise InputError(f"radius must be positive: particle {k} has radius {r[k]!r}")
+            raise InputError(f"radius must be positive: particle {k} has radius {float(r[k])!r}")
         rho = np.broadcast_to(np.asarray(density, dtype=float), (n,)).copy()
         bad = ~(np.isfinite(rho) & (rho > 0))
         if bad.any():
             k = int(np.argmax(bad))
-            raise InputError(f"density must be positive: particle {k} has density {rho[k]!r}")
+            raise InputError(f"density must be positive: particle {k} has density {float(rho[k])!r}")
         if contact is None:
             raise InputError("contact must be given: a law such as tdem.LinearContact(kn=...)")
-        law = self._law_id(contact)
         vel = np.zeros((n, 2)) if velocity is None else _as_xy("velocity", velocity, n)
+        law = self._law_id(contact)
         state = self._download() if self._built else None
         ids = np.arange(self._n, self._n + n)
         self._host["pos"].append(pos)
@@ -294,13 +305,13 @@ class Simulation:
                  center=None):
         """Add a rigid segment from p0 to p1; it moves with ``velocity`` and rotates at
         ``angular_velocity`` (rad/s) about ``center`` (default: its midpoint)."""
-        a, b = _as_xy("p0, p1", [p0, p1])
+        a, b = _vector2("p0", p0), _vector2("p1", p1)
         if np.allclose(a, b):
             raise InputError(f"p1 must differ from p0, got p0={a.tolist()} p1={b.tolist()}")
         if contact is None:
             raise InputError("contact must be given: a law such as tdem.LinearContact(kn=...)")
-        v = _as_xy("velocity", [velocity])[0]
-        c = 0.5 * (a + b) if center is None else _as_xy("center", [center])[0]
+        v = _vector2("velocity", velocity)
+        c = 0.5 * (a + b) if center is None else _vector2("center", center)
         w = float(angular_velocity)
         if not math.isfinite(w):
             raise InputError(f"angular_velocity must be finite, got {angular_velocity!r}")
@@ -853,6 +864,7 @@ class Simulation:
 
     # ------------------------------------------------------------------ reading
     def _particles_numpy(self, stress=True):
+        """Particle state; ``stress=False`` skips the stress (computed from the contacts)."""
         if not self._built:
             self._build()
         a = self._a
@@ -865,8 +877,9 @@ class Simulation:
             "displacement": pos - a["pos0"].to_numpy(),
         }
         if stress:
-            s = np.zeros((self._n, 3))
-            sa = ti.ndarray(ti.f64, (self._n, 3))
+            sa = self._a.get("stress_out")
+            if sa is None or sa.shape[0] != self._n:
+                sa = self._a["stress_out"] = ti.ndarray(ti.f64, (self._n, 3))
             stepk.particle_stress(a["prop"], a["nbr"], a["ncnt"], a["cn"], a["cf"], a["cs"],
                                   a["rev"], a["rcnt"], a["wid"], a["wcn"], a["wcf"], a["wcs"],
                                   sa)
