@@ -1,0 +1,76 @@
+"""The ``tdem`` command and the case scripts it runs."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tdem import cli
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_list_names_the_cases(capsys):
+    assert cli.main(["list"]) == 0
+    out = capsys.readouterr().out
+    assert "nine_disc" in out and "photoelastic" in out
+    line = next(l for l in out.splitlines() if l.startswith("nine_disc"))
+    assert "Cundall" in line
+
+
+def test_python_m_tdem_list():
+    r = subprocess.run([sys.executable, "-m", "tdem", "list"], cwd=ROOT, capture_output=True,
+                       text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "nine_disc" in r.stdout and "photoelastic" in r.stdout
+
+
+def test_unknown_case_exits_2(capsys):
+    assert cli.main(["run", "no_such_case"]) == 2
+    err = capsys.readouterr().err
+    assert "no_such_case" in err and "nine_disc" in err and "photoelastic" in err
+
+
+def test_no_command_exits_2(capsys):
+    assert cli.main([]) == 2
+
+
+def _summary(out):
+    with open(out / "summary.json") as f:
+        return json.load(f)
+
+
+def test_photoelastic_quick(tmp_path):
+    out = tmp_path / "pe"
+    assert cli.main(["run", "photoelastic", "--preset", "quick", "--out", str(out)]) == 0
+    s = _summary(out)
+    ratio = s["figures"]["F_H_over_F_V"]
+    assert ratio["target"] == pytest.approx(0.39)
+    assert abs(ratio["value"] - 0.39) <= 0.1
+    walls = s["table1"]["stage_A"]["walls"]
+    assert len(walls) == 4
+    for w in walls:
+        assert {"F1", "F2", "e_over_half_L_percent"} <= set(w)
+    # equilibrium of the walls' forces (the discs are at rest)
+    assert abs(sum(w["F1"] for w in walls)) < 0.01 * s["table1"]["stage_A"]["F_V"]
+    assert abs(sum(w["F2"] for w in walls)) < 0.01 * s["table1"]["stage_A"]["F_V"]
+    assert (out / "fig11_force_vectors.png").stat().st_size > 0
+    assert list(out.glob("*.pvd"))
+
+
+def test_nine_disc_quick(tmp_path):
+    out = tmp_path / "nd"
+    assert cli.main(["run", "nine_disc", "--preset", "quick", "--out", str(out)]) == 0
+    s = _summary(out)
+    for fig in s["figures"].values():
+        assert {"value", "target", "unit", "note"} <= set(fig)
+    amp = s["figures"]["undamped_amplitude_over_F_eq"]["value"]
+    assert 0.08 <= amp <= 0.25
+    assert abs(s["figures"]["damped_final_over_F_eq_from_undamped_mean"]["value"] - 1) < 0.02
+    assert s["figures"]["fig7a_amplitude_ratio_fast_over_slow"]["value"] > 1
+    for png in ("fig5b_force_vectors.png", "fig6_damping.png", "fig7_loading_speed.png",
+                "fig9_distortion.png"):
+        assert (out / png).stat().st_size > 0
+    assert (out / "histories.h5").exists()
+    assert list(out.glob("*.pvd"))
