@@ -20,6 +20,9 @@ import math
 
 import taichi as ti
 
+from tdem.errors import InputError
+
+from .rolling import RollingResistance
 from .validate import non_negative
 
 LAW_WIDTH = 12
@@ -38,17 +41,28 @@ class ContactLaw:
         """Largest stiffness the law reaches for a particle of this radius (for Δt)."""
         raise NotImplementedError
 
-    @staticmethod
-    def _gamma_from_restitution(restitution):
-        if restitution is None:
-            return 0.0
-        e = float(restitution)
-        if not (0.0 < e <= 1.0) or math.isnan(e):
-            raise ValueError  # replaced by the caller's message
-        if e == 1.0:
-            return 0.0
-        le = math.log(1.0 / e)
-        return 2.0 * le / math.sqrt(math.pi ** 2 + le ** 2)
+    def _set_common(self, friction, cohesion, restitution, damping_ratio, rolling):
+        """Friction, cohesion and damping shared by every law, validated."""
+        self.friction = non_negative("friction", friction)
+        self.cohesion = non_negative("cohesion", cohesion)
+        self.damping_ratio = non_negative("damping_ratio", damping_ratio)
+        self._gamma = 0.0
+        self.restitution = None
+        if restitution is not None:
+            try:
+                e = float(restitution)
+            except (TypeError, ValueError):
+                e = float("nan")
+            if not 0.0 < e <= 1.0:
+                raise InputError(f"restitution must lie in (0, 1], got {restitution!r}")
+            self.restitution = e
+            if e < 1.0:
+                le = math.log(1.0 / e)
+                self._gamma = 2.0 * le / math.sqrt(math.pi ** 2 + le ** 2)
+        if rolling is not None and not isinstance(rolling, RollingResistance):
+            raise InputError(f"rolling must be a tdem.RollingResistance or None, "
+                             f"got {rolling!r}")
+        self.rolling = rolling
 
     def _rolling_columns(self):
         r = self.rolling
@@ -67,7 +81,6 @@ class ContactLaw:
     def from_dict(d):
         from .hertz_mindlin import HertzMindlin
         from .linear import LinearContact
-        from .rolling import RollingResistance
         d = dict(d)
         cls = {"LinearContact": LinearContact, "HertzMindlin": HertzMindlin}[d.pop("type")]
         if "rolling" in d:
@@ -77,11 +90,6 @@ class ContactLaw:
     def __repr__(self):
         args = ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items() if k != "type")
         return f"{type(self).__name__}({args})"
-
-
-def check_friction_cohesion(friction, cohesion, damping_ratio):
-    return (non_negative("friction", friction), non_negative("cohesion", cohesion),
-            non_negative("damping_ratio", damping_ratio))
 
 
 @ti.func

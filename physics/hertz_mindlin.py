@@ -12,9 +12,8 @@ forms, which go with the 4/3 prefactor. The sphere formula is used for discs, as
 2D DEM codes commonly do. A restitution coefficient sets a normal dashpot with
 Miyata Eq. 17 evaluated with the current tangent stiffness.
 """
-from tdem.errors import InputError
 
-from .contact_law import HERTZ, ContactLaw, check_friction_cohesion
+from .contact_law import HERTZ, ContactLaw
 from .validate import in_range, positive
 
 
@@ -25,14 +24,7 @@ class HertzMindlin(ContactLaw):
                  damping_ratio=0.0, rolling=None):
         self.young = positive("young", young)
         self.poisson = in_range("poisson", poisson, -1.0, 0.5, lo_open=True, hi_open=True)
-        self.friction, self.cohesion, self.damping_ratio = check_friction_cohesion(
-            friction, cohesion, damping_ratio)
-        try:
-            self._gamma = self._gamma_from_restitution(restitution)
-        except (ValueError, TypeError):
-            raise InputError(f"restitution must lie in (0, 1], got {restitution!r}") from None
-        self.restitution = None if restitution is None else float(restitution)
-        self.rolling = rolling
+        self._set_common(friction, cohesion, restitution, damping_ratio, rolling)
 
     @property
     def e_star(self):

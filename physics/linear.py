@@ -13,7 +13,7 @@ Eq. 17. The kernel side is in :func:`physics.contact_law.pair_force`.
 """
 from tdem.errors import InputError
 
-from .contact_law import LINEAR, ContactLaw, check_friction_cohesion
+from .contact_law import LINEAR, ContactLaw
 from .validate import positive
 
 
@@ -47,14 +47,7 @@ class LinearContact(ContactLaw):
             raise InputError(f"ks must be a number >= 0, got {ks!r}") from None
         if not self.ks >= 0.0 or self.ks == float("inf"):
             raise InputError(f"ks must be a number >= 0, got {ks!r}")
-        self.friction, self.cohesion, self.damping_ratio = check_friction_cohesion(
-            friction, cohesion, damping_ratio)
-        try:
-            self._gamma = self._gamma_from_restitution(restitution)
-        except (ValueError, TypeError):
-            raise InputError(f"restitution must lie in (0, 1], got {restitution!r}") from None
-        self.restitution = None if restitution is None else float(restitution)
-        self.rolling = rolling
+        self._set_common(friction, cohesion, restitution, damping_ratio, rolling)
 
     def row(self):
         return [float(LINEAR), self.kn, self.ks, self.friction, self.cohesion,
