@@ -41,9 +41,10 @@ class Monitor:
         self.steps, self.times, self.values = [], [], []
 
     def record(self, sim):
+        value = np.asarray(self.fn(sim), dtype=float)   # first: fn may raise
         self.steps.append(sim.steps)
         self.times.append(sim.time)
-        self.values.append(np.asarray(self.fn(sim), dtype=float))
+        self.values.append(value)
         self.next_step = sim.steps + self.every
 
     def truncate(self, step):

@@ -159,3 +159,36 @@ def test_unstable_run_leaves_last_good_state(tmp_path):
     # the series lists no snapshot after the last good step
     assert [s for s, _ in out.snapshots] == [0, 100, 200]
     assert not (tmp_path / "particles_00003.vtu").exists()
+
+
+def test_interrupted_run_flushes_output_and_keeps_a_consistent_state(tmp_path):
+    """Ctrl-C during a run: the state goes back to the last checked step (never a half
+    step), the monitors are flushed and last_good.h5 restarts exactly from it."""
+    sim = _pile(n=100, seed=3)
+    sim.check_interval = 40
+    calls = []
+
+    def interrupt_at_130(s):
+        calls.append(s.steps)
+        if s.steps == 130:
+            raise KeyboardInterrupt
+        return s.steps
+
+    sim.monitor("steps", interrupt_at_130, every=10)
+    sim.output(tmp_path, every=50)
+    with pytest.raises(KeyboardInterrupt):
+        sim.run(steps=300)
+    assert sim.steps == 120                      # the last check before the interrupt
+    assert sim.histories()["steps"][1].tolist() == list(range(10, 130, 10))
+    with h5py.File(tmp_path / "last_good.h5", "r") as f:
+        assert f.attrs["abort_reason"] == "interrupted"
+    good = tdem.Simulation.load(tmp_path / "last_good.h5")
+    assert good.steps == 120
+    assert np.array_equal(good.particles.numpy()["position"], sim.particles.numpy()["position"])
+    assert read_monitors(tmp_path / "monitors.h5")["steps"][1].tolist() == list(range(10, 130, 10))
+    # both continue identically
+    sim._monitors.clear()
+    sim._output = None
+    sim.run(steps=60)
+    good.run(steps=60)
+    assert np.array_equal(good.particles.numpy()["position"], sim.particles.numpy()["position"])
