@@ -229,6 +229,7 @@ class Simulation:
         self._output = None
         self._fix_fn = None
         self._crit_cache = None
+        self._skin_auto = None
         self._last_fit = 0
         self._next_event = 1 << 62
         if dt is not None:
@@ -394,10 +395,13 @@ class Simulation:
 
     @property
     def skin(self):
+        """Verlet skin (m): the given one, else 0.4 × the smallest radius."""
         if self._skin_user is not None:
             return self._skin_user
-        r = self._radii()
-        return 0.4 * float(r.min()) if len(r) else 0.0
+        if self._skin_auto is None or self._skin_auto[0] != self._n:
+            r = self._radii()
+            self._skin_auto = (self._n, 0.4 * float(r.min()) if len(r) else 0.0)
+        return self._skin_auto[1]
 
     def _radii(self):
         if self._built:
