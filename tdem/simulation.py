@@ -230,6 +230,7 @@ class Simulation:
         self._fix_fn = None
         self._crit_cache = None
         self._skin_auto = None
+        self._host_reads_flag = self.arch == "cpu"
         self._last_fit = 0
         self._next_event = 1 << 62
         if dt is not None:
@@ -689,10 +690,12 @@ class Simulation:
                 a["wall"], a["wid"], a["whist"], a["wid_old"], a["whist_old"],
                 len(self._walls_host), float(self.skin))
 
-    def _one_step(self, step_args, rebuild_args, on_cpu, detail):
+    def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
         if self._fix_fn:
             self._apply_fixes(t=self._time)
-        if not on_cpu or self._a["flags"][F_REBUILD] != 0:
+        # on a GPU the rebuild kernel runs every step and returns at once unless the
+        # device raised the flag; on the CPU the host reads the flag (shared memory)
+        if not host_reads_flag or self._a["flags"][F_REBUILD] != 0:
             neighbors.rebuild(*rebuild_args)
         stepk.step(*step_args, detail)
         self._time += self._dt_run
@@ -798,11 +801,11 @@ class Simulation:
         n = min(self.check_interval, target - self._steps)
         self._take_snapshot()
         sargs, rargs = self._step_args(), self._rebuild_args()
-        on_cpu = self.arch == "cpu"
+        host_flag = self._host_reads_flag
         for s in range(n):
             # output-only quantities are stored on the steps something will read them
             detail = s == n - 1 or self._steps + 1 >= self._next_event
-            self._one_step(sargs, rargs, on_cpu, detail)
+            self._one_step(sargs, rargs, host_flag, detail)
             if self._steps >= self._next_event:
                 self._events()
         flags = self._status()
@@ -819,10 +822,10 @@ class Simulation:
         """Replay the last segment one step at a time to name the failing step."""
         self._restore_snapshot()
         sargs, rargs = self._step_args(), self._rebuild_args()
-        on_cpu = self.arch == "cpu"
+        host_flag = self._host_reads_flag
         for _ in range(self.check_interval + 1):
             self._take_snapshot()
-            self._one_step(sargs, rargs, on_cpu, True)
+            self._one_step(sargs, rargs, host_flag, True)
             flags = self._status()
             if flags[F_BAD] < self._n:
                 k = int(flags[F_BAD])
