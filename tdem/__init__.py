@@ -6,10 +6,11 @@ the errors :class:`InputError`, :class:`InstabilityError`.
 """
 from physics import HertzMindlin, LinearContact, RollingResistance
 
+from . import mesh, pack
 from .errors import CapacityError, InputError, InstabilityError
 from .simulation import ParticleGroup, Simulation, Wall
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "ParticleGroup", "Wall", "LinearContact", "HertzMindlin",
+__all__ = ["mesh", "pack", "Simulation", "ParticleGroup", "Wall", "LinearContact", "HertzMindlin",
            "RollingResistance", "InputError", "InstabilityError", "CapacityError"]
