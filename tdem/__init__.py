@@ -5,6 +5,7 @@ The public API (see README): :class:`Simulation`, the contact laws
 the errors :class:`InputError`, :class:`InstabilityError`.
 """
 from physics import HertzMindlin, LinearContact, RollingResistance
+from physics.materials import Elastic, Fluid, MohrCoulomb
 
 from . import mesh, pack
 from .errors import CapacityError, InputError, InstabilityError
@@ -12,5 +13,6 @@ from .simulation import ParticleGroup, Simulation, Wall
 
 __version__ = "0.1.0"
 
-__all__ = ["mesh", "pack", "Simulation", "ParticleGroup", "Wall", "LinearContact", "HertzMindlin",
-           "RollingResistance", "InputError", "InstabilityError", "CapacityError"]
+__all__ = ["Simulation", "ParticleGroup", "Wall", "LinearContact", "HertzMindlin",
+           "RollingResistance", "Elastic", "MohrCoulomb", "Fluid", "InputError",
+           "InstabilityError", "CapacityError", "mesh", "pack"]

@@ -1,0 +1,501 @@
+"""Continuum materials of PCMM particles and deformable blocks, and the
+Mohr–Coulomb correction of Feng, Li & Oñate (2015), Eq. 12.
+
+Sign conventions
+----------------
+Stress is **tension-positive**; pressure p = −(σxx + σyy + σzz)/3. Plane strain:
+the stress of a particle is the vector s = (σxx, σyy, σxy, σzz), σzz tracked and
+part of the yield check. Principal stresses are ordered σ1 ≤ σ2 ≤ σ3, so σ1 is
+the most compressive one (the FLAC convention, which is also tension-positive).
+
+Elastic constants: K = E/(3(1 − 2ν)), G = E/(2(1 + ν)); in principal axes
+Δσ_i = α1 Δε_i + α2 (Δε_j + Δε_k) with α1 = K + 4G/3, α2 = K − 2G/3.
+P-wave speed c_p = sqrt((K + 4G/3)/ρ).
+
+Mohr–Coulomb with a tension cut-off (FLAC plane-strain return in principal stresses)
+-------------------------------------------------------------------------------------
+N_φ = (1 + sin φ)/(1 − sin φ), N_ψ = (1 + sin ψ)/(1 − sin ψ), T the tensile
+strength (σt), c the cohesion.
+
+- shear:   f_s = σ1 − σ3 N_φ + 2c sqrt(N_φ);   admissible f_s ≥ 0 (failure f_s < 0)
+- tension: f_t = σ3 − T;                        admissible f_t ≤ 0 (failure f_t > 0)
+
+(FLAC writes the tension function as T − σ3 ≥ 0; here f_t = σ3 − T, so a stress on
+the surface has f = 0 for both and "inside" means f_s ≥ 0, f_t ≤ 0.) Uniaxial
+compressive strength: σ_c = 2c sqrt(N_φ) = 2c cos φ/(1 − sin φ).
+
+The tension cut-off cannot lie beyond the apex of the shear cone: when φ > 0 the
+tensile strength is **capped** at T_max = c/tan φ (as FLAC does); ``tensile_strength``
+keeps the value given and ``tension`` the one used. The same cap applies to the
+residual values of brittle softening.
+
+Domain split (FLAC): with α^P = sqrt(1 + N_φ²) + N_φ and σ^P = T N_φ − 2c sqrt(N_φ),
+h = σ3 − T + α^P (σ1 − σ^P) is the diagonal between the shear and tension yield
+lines in the (σ1, σ3) plane. A failing trial stress with h ≤ 0 returns in shear,
+with h > 0 in tension:
+
+- shear (plastic potential g_s = σ1 − σ3 N_ψ):
+  λ_s = f_s(σ1, σ3)/[(α1 − α2 N_ψ) − (α2 − α1 N_ψ) N_φ],
+  σ1 ← σ1 − λ_s (α1 − α2 N_ψ), σ2 ← σ2 − λ_s α2 (1 − N_ψ), σ3 ← σ3 − λ_s (α2 − α1 N_ψ)
+  (λ_s < 0; the plastic principal strains are Δε1 = λ_s, Δε3 = −λ_s N_ψ);
+- tension (potential g_t = −σ3):
+  σ3 ← T, σ1 ← σ1 − (σ3 − T) α2/α1, σ2 ← σ2 − (σ3 − T) α2/α1.
+
+Corners. FLAC's one-surface returns can leave the stress outside another part of the
+composite surface (near the edges σ1 = σ2 or σ2 = σ3 of the cone, and near the apex
+where shear and tension meet, or where two principal stresses exceed T). The
+correction therefore works on the three principal values with their directions
+fixed and all nine planes of the criterion written for every ordering (six shear
+planes N_φ s_j − s_i − 2c sqrt(N_φ) ≤ 0, i ≠ j, and three tension planes
+s_k − T ≤ 0). A return with the active planes A solves, for the multipliers
+Δγ_a ≥ 0, the consistency conditions F_b(σᴵ − Σ_a Δγ_a D m_a) = 0 for every b in A
+(D the elastic matrix in principal axes, m_a the flow direction of plane a: the
+FLAC flow rules above). FLAC's choice (one plane, from h) is tried first; when its
+result violates another plane by more than a relative 1e-12, the first admissible
+active set (all Δγ ≥ 0, no plane violated) is taken, trying one plane, then two
+(the cone edges, the shear–tension corner, two tension planes), then three (the
+cone edge at the cut-off, the hydrostatic tension apex σ1 = σ2 = σ3 = T). When
+FLAC's one-surface return is admissible — the ordinary case — the result is
+exactly the FLAC result above.
+
+Plastic shear strain increment (FLAC's shear hardening measure):
+Δe^ps = sqrt(½ Σ_i (Δε_i^ps − Δε_m^ps)²), Δε_m^ps = (Σ_i Δε_i^ps)/3, summed over the
+shear planes' plastic strains only (for the plain shear return this is FLAC's
+sqrt(½(Δε1 − Δε_m)² + ½Δε_m² + ½(Δε3 − Δε_m)²)). A pure tension return gives 0.
+
+Back to x–y: the in-plane principal directions do not change; with the in-plane
+centre C = (σxx + σyy)/2, radius R = sqrt(((σxx − σyy)/2)² + σxy²) and
+(cos 2θ, sin 2θ) = ((σxx − σyy)/2, σxy)/R (taken (1, 0) when R = 0), the new
+in-plane principals (a ≤ b, a = C − R, b = C + R before the correction) give
+σxx = C′ + R′ cos 2θ, σyy = C′ − R′ cos 2θ, σxy = R′ sin 2θ, C′ = (a′ + b′)/2,
+R′ = (b′ − a′)/2; σzz is the third principal value, whatever its rank.
+
+Material table
+--------------
+Every material packs into one row of ``MAT_WIDTH`` floats so that kernels can read
+any material from one 2D array ``matp[M, col]``:
+
+====  ==============================================================
+0     type: 0 Elastic, 1 Mohr–Coulomb, 2 Fluid
+1     density ρ (kg/m³)
+2     bulk modulus K (Pa)
+3     shear modulus G (Pa) (0 for a Fluid)
+4     cohesion c (Pa)                         (Mohr–Coulomb, else 0)
+5     tension cut-off T in use, capped (Pa)   (Mohr–Coulomb, else 0)
+6     N_φ = (1 + sin φ)/(1 − sin φ)           (Mohr–Coulomb, else 1)
+7     N_ψ = (1 + sin ψ)/(1 − sin ψ)           (Mohr–Coulomb, else 1)
+8     brittle softening: 1 on, 0 off
+9     residual cohesion c_r (Pa)               (used after first failure if brittle)
+10    residual tension T_r in use, capped (Pa)
+11    dynamic viscosity μ (Pa·s)              (Fluid, else 0)
+====  ==============================================================
+"""
+import math
+
+import taichi as ti
+
+from tdem.errors import InputError
+
+from .validate import in_range, non_negative, positive
+
+MAT_WIDTH = 12
+ELASTIC, MOHR_COULOMB, FLUID = 0, 1, 2
+NO_FAILURE, SHEAR_FAILURE, TENSION_FAILURE = 0, 1, 2
+
+
+def _n_angle(deg):
+    s = math.sin(math.radians(deg))
+    return (1.0 + s) / (1.0 - s)
+
+
+def _tension_cap(cohesion, friction_angle):
+    """T_max = c/tan φ (infinite for φ = 0)."""
+    if friction_angle == 0.0:
+        return math.inf
+    return cohesion / math.tan(math.radians(friction_angle))
+
+
+class Material:
+    """Base class of continuum materials: validation, derived moduli, table row."""
+
+    bulk = 0.0
+    shear = 0.0
+    density = 0.0
+
+    @property
+    def p_wave_speed(self):
+        """c_p = sqrt((K + 4G/3)/ρ) (m/s)."""
+        return math.sqrt((self.bulk + 4.0 * self.shear / 3.0) / self.density)
+
+    def row(self):
+        raise NotImplementedError
+
+    def _elastic(self, density, young, poisson):
+        self.density = positive("density", density)
+        self.young = positive("young", young)
+        self.poisson = in_range("poisson", poisson, -1.0, 0.5, lo_open=True, hi_open=True)
+        self.bulk = self.young / (3.0 * (1.0 - 2.0 * self.poisson))
+        self.shear = self.young / (2.0 * (1.0 + self.poisson))
+
+    def to_dict(self):
+        d = {k: v for k, v in self.__dict__.items()
+             if not k.startswith("_") and k in self._ARGS}
+        d["type"] = type(self).__name__
+        return d
+
+    @staticmethod
+    def from_dict(d):
+        d = dict(d)
+        kind = d.pop("type", None)
+        classes = {"Elastic": Elastic, "MohrCoulomb": MohrCoulomb, "Fluid": Fluid}
+        if kind not in classes:
+            raise InputError(f"type must be one of {sorted(classes)}, got {kind!r}")
+        return classes[kind](**d)
+
+    def __repr__(self):
+        args = ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items() if k != "type")
+        return f"{type(self).__name__}({args})"
+
+    def __eq__(self, other):
+        return type(self) is type(other) and self.to_dict() == other.to_dict()
+
+    def __hash__(self):
+        return hash(tuple(sorted(self.to_dict().items())))
+
+
+class Elastic(Material):
+    """Linear isotropic elasticity (plane strain, σzz tracked).
+
+    Parameters
+    ----------
+    density : ρ (kg/m³), > 0
+    young : Young's modulus E (Pa), > 0
+    poisson : Poisson's ratio ν in (−1, 0.5)
+
+    K = E/(3(1 − 2ν)), G = E/(2(1 + ν)). ``mc_correct`` leaves the stress unchanged.
+    """
+
+    _ARGS = ("density", "young", "poisson")
+
+    def __init__(self, density=2500.0, young=30e9, poisson=0.25):
+        self._elastic(density, young, poisson)
+
+    def row(self):
+        return [float(ELASTIC), self.density, self.bulk, self.shear,
+                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0]
+
+
+class MohrCoulomb(Material):
+    """Elastic–plastic Mohr–Coulomb with a tension cut-off (FLAC plane strain).
+
+    Parameters
+    ----------
+    density, young, poisson : as :class:`Elastic`
+    cohesion : c (Pa), ≥ 0
+    friction_angle : φ in degrees, in [0, 90)
+    tensile_strength : T (Pa), ≥ 0; capped at c/tan φ when φ > 0 (the value in use
+        is ``tension``)
+    dilation_angle : ψ in degrees, in [0, φ] (0: no plastic volume change)
+    brittle : after a particle's first failure its c and T drop to the residual values
+    residual_cohesion, residual_tensile_strength : c_r, T_r (Pa), ≥ 0, default 0;
+        c_r ≤ c and T_r ≤ T
+
+    Yield functions, flow rules and the return are in the module docstring.
+    """
+
+    _ARGS = ("density", "young", "poisson", "cohesion", "friction_angle",
+             "tensile_strength", "dilation_angle", "brittle", "residual_cohesion",
+             "residual_tensile_strength")
+
+    def __init__(self, density=2500.0, young=30e9, poisson=0.25, cohesion=3e6,
+                 friction_angle=40.0, tensile_strength=1e6, dilation_angle=0.0,
+                 brittle=False, residual_cohesion=0.0, residual_tensile_strength=0.0):
+        self._elastic(density, young, poisson)
+        self.cohesion = non_negative("cohesion", cohesion)
+        self.friction_angle = in_range("friction_angle", friction_angle, 0.0, 90.0,
+                                       hi_open=True)
+        self.tensile_strength = non_negative("tensile_strength", tensile_strength)
+        self.dilation_angle = in_range("dilation_angle", dilation_angle, 0.0,
+                                       self.friction_angle)
+        if isinstance(brittle, str) or brittle not in (0, 1):
+            raise InputError(f"brittle must be True or False, got {brittle!r}")
+        self.brittle = bool(brittle)
+        self.residual_cohesion = in_range("residual_cohesion", residual_cohesion,
+                                          0.0, self.cohesion)
+        self.residual_tensile_strength = in_range(
+            "residual_tensile_strength", residual_tensile_strength, 0.0,
+            self.tensile_strength)
+        if self.friction_angle == 0.0 and self.cohesion == 0.0:
+            raise InputError("cohesion must be > 0 when friction_angle is 0 "
+                             "(no shear strength at all), got cohesion=0")
+
+    @property
+    def n_phi(self):
+        return _n_angle(self.friction_angle)
+
+    @property
+    def n_psi(self):
+        return _n_angle(self.dilation_angle)
+
+    @property
+    def tension(self):
+        """Tension cut-off in use: min(T, c/tan φ)."""
+        return min(self.tensile_strength, _tension_cap(self.cohesion, self.friction_angle))
+
+    @property
+    def residual_tension(self):
+        return min(self.residual_tensile_strength,
+                   _tension_cap(self.residual_cohesion, self.friction_angle))
+
+    @property
+    def compressive_strength(self):
+        """Uniaxial compressive strength 2c cos φ/(1 − sin φ) = 2c sqrt(N_φ)."""
+        return 2.0 * self.cohesion * math.sqrt(self.n_phi)
+
+    def row(self):
+        return [float(MOHR_COULOMB), self.density, self.bulk, self.shear,
+                self.cohesion, self.tension, self.n_phi, self.n_psi,
+                1.0 if self.brittle else 0.0, self.residual_cohesion,
+                self.residual_tension, 0.0]
+
+
+class Fluid(Material):
+    """Water-like material (Feng et al. §4.3): G = 0, bulk modulus K.
+
+    Parameters
+    ----------
+    density : ρ (kg/m³), > 0
+    bulk_modulus : K (Pa), > 0 (the paper: 2 GPa; a case may lower it, see §3)
+    viscosity : dynamic viscosity μ (Pa·s), ≥ 0 (its stress is handled by the
+        element update, not by ``mc_correct``, which leaves the stress unchanged)
+    """
+
+    _ARGS = ("density", "bulk_modulus", "viscosity")
+
+    def __init__(self, density=1000.0, bulk_modulus=2e9, viscosity=0.0):
+        self.density = positive("density", density)
+        self.bulk_modulus = positive("bulk_modulus", bulk_modulus)
+        self.viscosity = non_negative("viscosity", viscosity)
+        self.bulk = self.bulk_modulus
+        self.shear = 0.0
+
+    def row(self):
+        return [float(FLUID), self.density, self.bulk, 0.0,
+                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, self.viscosity]
+
+
+# ------------------------------------------------------------------ kernel side
+@ti.func
+def _plane(k, nphi, npsi, sq, coh, ten):
+    """Plane k of the composite criterion on unsorted principal values s (3,).
+
+    k < 6: shear plane (i, j) = (k // 2, the k % 2-th other index):
+    F = N_φ s_j − s_i − 2c sqrt(N_φ) ≤ 0, flow m_i = −1, m_j = N_ψ.
+    k ≥ 6: tension plane F = s_(k−6) − T ≤ 0, flow m_(k−6) = 1.
+    Returns (gradient n, constant, flow m): F = n·s + constant.
+    """
+    n = ti.Vector([0.0, 0.0, 0.0])
+    m = ti.Vector([0.0, 0.0, 0.0])
+    const = 0.0
+    if k < 6:
+        i = k // 2
+        j = k % 2
+        if j >= i:
+            j += 1
+        for q in ti.static(range(3)):
+            if q == i:
+                n[q] = -1.0
+                m[q] = -1.0
+            if q == j:
+                n[q] = nphi
+                m[q] = npsi
+        const = -2.0 * coh * sq
+    else:
+        for q in ti.static(range(3)):
+            if q == k - 6:
+                n[q] = 1.0
+                m[q] = 1.0
+        const = -ten
+    return n, const, m
+
+
+@ti.func
+def _dmul(v, a1, a2):
+    """Elastic matrix in principal axes times v: α1 v_i + α2 (v_j + v_k)."""
+    tr = v[0] + v[1] + v[2]
+    return (a1 - a2) * v + a2 * tr * ti.Vector([1.0, 1.0, 1.0])
+
+
+@ti.func
+def _solve_active(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2):
+    """Multipliers Δγ (vector, unused slots 0) and corrected principals for the
+    active planes act[0:nact]: Σ_c (n_b·D m_c) Δγ_c = F_b(p) for every active b.
+    Returns (ok, Δγ, principals); ok = 0 when the planes are dependent."""
+    A = ti.Matrix.identity(ti.f64, 3)
+    r = ti.Vector([0.0, 0.0, 0.0])
+    for b in ti.static(range(3)):
+        if b < nact:
+            nb, kb, mb = _plane(act[b], nphi, npsi, sq, coh, ten)
+            r[b] = nb.dot(p) + kb
+            for c in ti.static(range(3)):
+                if c < nact:
+                    nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
+                    A[b, c] = nb.dot(_dmul(mc, a1, a2))
+    g = ti.Vector([0.0, 0.0, 0.0])
+    # a set of dependent planes (singular matrix, relative to its row sizes) fails
+    size = 1.0
+    for b in ti.static(range(3)):
+        size *= ti.abs(A[b, 0]) + ti.abs(A[b, 1]) + ti.abs(A[b, 2])
+    det = A.determinant()
+    ok = 0
+    if ti.abs(det) > 1e-10 * size:
+        ok = 1
+        if nact == 1:
+            g[0] = r[0] / A[0, 0]
+        else:
+            g = A.inverse() @ r
+    q = p
+    for c in ti.static(range(3)):
+        if c < nact:
+            nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
+            q -= g[c] * _dmul(mc, a1, a2)
+    return ok, g, q
+
+
+@ti.func
+def _try(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2, tol):
+    """Return with the active planes act[0:nact]; ok = 1 when every multiplier is
+    ≥ 0 and the result violates no plane of the criterion by more than tol."""
+    ok, g, q = _solve_active(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2)
+    for c in ti.static(range(3)):
+        if c < nact and g[c] < 0.0:
+            ok = 0
+    if ok == 1:
+        for k in range(9):
+            nk, ck, mk = _plane(k, nphi, npsi, sq, coh, ten)
+            if nk.dot(q) + ck > tol:
+                ok = 0
+    return ok, g, q
+
+
+@ti.func
+def mc_correct_state(s, matp: ti.template(), M, failed):
+    """Mohr–Coulomb + tension cut-off correction of a trial stress (module docstring).
+
+    s: trial stress (σxx, σyy, σxy, σzz), tension-positive; M: row of ``matp``;
+    failed: nonzero when the particle has failed before (brittle softening then uses
+    the residual c_r, T_r of columns 9–10).
+    Returns (corrected stress, plastic shear strain increment Δe^ps ≥ 0, flag:
+    0 no failure, 1 shear (a shear plane is active, alone or at a corner with the
+    cut-off), 2 tension only). Elastic and Fluid rows return s unchanged. A kernel
+    doing brittle softening marks the particle failed once flag > 0.
+    A stress inside the surface is returned unchanged (bitwise).
+    """
+    out = s
+    eps = 0.0
+    flag = NO_FAILURE
+    kind = ti.cast(matp[M, 0], ti.i32)
+    if kind == MOHR_COULOMB:
+        K = matp[M, 2]
+        G = matp[M, 3]
+        coh = matp[M, 4]
+        ten = matp[M, 5]
+        if failed != 0 and matp[M, 8] != 0.0:
+            coh = matp[M, 9]
+            ten = matp[M, 10]
+        nphi = matp[M, 6]
+        npsi = matp[M, 7]
+        sq = ti.sqrt(nphi)
+        a1 = K + 4.0 * G / 3.0
+        a2 = K - 2.0 * G / 3.0
+        # in-plane principal values a ≤ b, direction (cos 2θ, sin 2θ) of b
+        cen = 0.5 * (s[0] + s[1])
+        d = 0.5 * (s[0] - s[1])
+        rad = ti.sqrt(d * d + s[2] * s[2])
+        c2 = 1.0
+        s2 = 0.0
+        if rad > 0.0:
+            c2 = d / rad
+            s2 = s[2] / rad
+        p = ti.Vector([cen - rad, cen + rad, s[3]])
+        # sorted: i1 (most compressive), i3 (most tensile)
+        i1 = 0
+        i3 = 1
+        if p[2] < p[0]:
+            i1 = 2
+        elif p[2] > p[1]:
+            i3 = 2
+        s1 = p[i1]
+        s3 = p[i3]
+        fs = s1 - s3 * nphi + 2.0 * coh * sq
+        ft = s3 - ten
+        if fs < 0.0 or ft > 0.0:
+            scale = ti.abs(p[0]) + ti.abs(p[1]) + ti.abs(p[2]) + coh + ten
+            tol = 1e-12 * scale
+            # FLAC's domain split
+            ap = ti.sqrt(1.0 + nphi * nphi) + nphi
+            sp = ten * nphi - 2.0 * coh * sq
+            h = s3 - ten + ap * (s1 - sp)
+            act = ti.Vector([0, 0, 0])
+            nact = 1
+            if h <= 0.0 and fs < 0.0:
+                k = 2 * i1 + i3          # shear plane (i1, i3)
+                if i3 > i1:
+                    k -= 1
+                act[0] = k
+            else:
+                act[0] = 6 + i3
+            ok, g, q = _try(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2, tol)
+            # FLAC's return not admissible: the first admissible active set, by size
+            if ok == 0:
+                act0 = act
+                g0 = g
+                q0 = q
+                for size in range(1, 4):
+                    for ka in range(9):
+                        for kb in range(9):
+                            for kc in range(9):
+                                if ok == 0:
+                                    use = 0
+                                    if size == 1 and kb == 0 and kc == 0:
+                                        use = 1
+                                    elif size == 2 and kb > ka and kc == 0:
+                                        use = 1
+                                    elif size == 3 and kb > ka and kc > kb:
+                                        use = 1
+                                    if use == 1:
+                                        act = ti.Vector([ka, kb, kc])
+                                        nact = size
+                                        ok, g, q = _try(p, act, nact, nphi, npsi, sq, coh,
+                                                        ten, a1, a2, tol)
+                if ok == 0:          # none found (not expected): keep FLAC's return
+                    act = act0
+                    nact = 1
+                    g = g0
+                    q = q0
+            # plastic strains of the shear planes, failure type
+            eps_s = ti.Vector([0.0, 0.0, 0.0])
+            shear_part = 0
+            for c in ti.static(range(3)):
+                if c < nact:
+                    nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
+                    if act[c] < 6:
+                        eps_s += g[c] * mc
+                        shear_part = 1
+            em = (eps_s[0] + eps_s[1] + eps_s[2]) / 3.0
+            dev = eps_s - em * ti.Vector([1.0, 1.0, 1.0])
+            eps = ti.sqrt(0.5 * dev.dot(dev))
+            flag = TENSION_FAILURE
+            if shear_part == 1:
+                flag = SHEAR_FAILURE
+            # back to x–y
+            cn = 0.5 * (q[0] + q[1])
+            rn = 0.5 * (q[1] - q[0])
+            out = ti.Vector([cn + rn * c2, cn - rn * c2, rn * s2, q[2]])
+    return out, eps, flag
+
+
+@ti.func
+def mc_correct(s, matp: ti.template(), M):
+    """:func:`mc_correct_state` with the peak strength (no softening)."""
+    return mc_correct_state(s, matp, M, 0)
