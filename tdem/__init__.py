@@ -1,8 +1,10 @@
 """tdem: continuum–discontinuum simulation in geomechanics, on Taichi.
 
 The public API (see README): :class:`Simulation`, the contact laws
-:class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance`, and
-the errors :class:`InputError`, :class:`InstabilityError`.
+:class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance`, the
+continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, the
+geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
+:class:`InputError`, :class:`InstabilityError`.
 """
 from physics import HertzMindlin, LinearContact, RollingResistance
 from physics.materials import Elastic, Fluid, MohrCoulomb
