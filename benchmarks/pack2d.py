@@ -88,7 +88,6 @@ def main(argv=None):
     p.add_argument("--json", default=None, help="append the results to this JSON file")
     args = p.parse_args(argv)
     if args.scaling:
-        rows = []
         for n in (10_000, 20_000, 40_000, 80_000, 160_000):
             side = int(round(math.sqrt(n)))
             cmd = [sys.executable, __file__, "--threads", str(args.threads), "--steps",

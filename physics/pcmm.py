@@ -69,6 +69,8 @@ import taichi as ti
 from tdem import backend
 from tdem.errors import CapacityError, InputError
 
+from .validate import positive
+
 MAX_ELEMENTS = 12        # elements a particle can create (pruned gaps are >= 30 deg)
 MAX_CAPACITY = 1024      # largest Eq. 1 neighbour capacity ElementSystem grows to
 MIN_GAP = math.pi / 6.0  # angular pruning threshold (30 deg)
@@ -556,12 +558,7 @@ class ElementSystem:
 
     def masses(self, density):
         """Particle masses of Eq. 5 for the density ρ (kg/m³), per metre of thickness."""
-        try:
-            rho = float(density)
-        except (TypeError, ValueError):
-            raise InputError(f"density must be a positive number, got {density!r}") from None
-        if not (rho > 0.0 and math.isfinite(rho)):
-            raise InputError(f"density must be a positive number, got {density!r}")
+        rho = positive("density", density)
         self._require_built()
         a = self.arrays
         element_masses(a["rad"], rho, a["nbr"], a["nbr_cnt"], a["elem"], a["ecnt"],

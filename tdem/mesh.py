@@ -13,19 +13,11 @@ Conventions
 """
 import numpy as np
 
+from physics.validate import positive as _positive
+
 from .errors import InputError
 
 PATTERNS = ("regular", "cross")
-
-
-def _positive(name, value):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a positive number, got {value!r}") from None
-    if not (v > 0.0 and np.isfinite(v)):
-        raise InputError(f"{name} must be a positive number, got {value!r}")
-    return v
 
 
 def _count(name, value):

@@ -18,6 +18,8 @@ import math
 
 import numpy as np
 
+from physics.validate import positive as _positive
+
 from .errors import InputError
 
 # random packing: radius growth per sweep (from half size), momentum of the relaxation
@@ -25,16 +27,6 @@ _GROWTH = 0.002
 _MOMENTUM = 0.85
 # relative slack when counting how many lattice spacings fit in a length
 _FIT_EPS = 1e-9
-
-
-def _positive(name, value):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a positive number, got {value!r}") from None
-    if not (v > 0.0 and math.isfinite(v)):
-        raise InputError(f"{name} must be a positive number, got {value!r}")
-    return v
 
 
 def _origin(origin):

@@ -12,7 +12,6 @@ step and the particle, keeps the last good state and raises
 :class:`tdem.InstabilityError`.
 """
 import math
-import signal
 import sys
 import time as _time
 

@@ -9,7 +9,6 @@ so F_n = K_n u; one disc is spun at a prescribed ω, the relative rotation
 - Model 1: |M| ≤ M₀ = F_n B/6 (perfectly plastic), elastic unloading on reversal;
 - Model 2: M drops to 0 once |θ_r| > θ_r⁰ = 2 F_n/(K_n B) and stays 0.
 """
-import math
 
 import numpy as np
 import pytest
