@@ -31,7 +31,7 @@ MAX_SLOTS = 1024
 # name: (components, per-slot?, dtype kind). components 0 = scalar.
 _PARTICLE = {
     "pos": 2, "vel": 2, "omega": 0, "prop": 3, "plaw": "i", "fix": "i", "vfix": 3,
-    "force": 2, "torque": 0, "xref": 2, "pos0": 2, "facc": 5, "eacc": 2, "estate": 2,
+    "force": 2, "torque": 0, "xref": 2, "pos0": 2, "facc": 3, "eacc": 2, "estate": 2,
 }
 _SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
           "nbr_old": "i", "hist_old": 4}
@@ -538,7 +538,7 @@ class Simulation:
             if k in self._a:
                 self._fill(k, v)
         self._built = True
-        self._a["facc"].from_numpy(np.zeros((n, 5)))  # sums start from zero every step
+        self._a["facc"].from_numpy(np.zeros((n, 3)))  # sums start from zero every step
         self._upload_laws()
         self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.WALL_WIDTH), fresh=True)
         self._fit_grid(force=True)

@@ -217,16 +217,18 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             diss += dk
             if ti.static(serial):
                 j = nbr[i, k]
-                facc[j] += ti.Vector([-fk[0], -fk[1], mjk, 0.0, 0.0])
+                facc[j] += ti.Vector([-fk[0], -fk[1], mjk])
             if ti.static(detail or not serial):
                 cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
         fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
                                          whist, wcn, wcf, wcs, dt)
-        own = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw, diss + dw, work])
+        own = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw])
         if ti.static(serial):
             facc[i] += own
         else:
             facc[i] = own
+        if diss != 0.0 or dw != 0.0 or work != 0.0:
+            eacc[i] += ti.Vector([diss + dw, work])
 
     # 2. gather the partners' share, damp, integrate (leapfrog), skin check
     ti.loop_config(serialize=serial)
@@ -235,7 +237,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         f = ti.Vector([a[0], a[1]])
         tq = a[2]
         if ti.static(serial):
-            facc[i] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
+            facc[i] = ti.Vector([0.0, 0.0, 0.0])
         else:
             for r in range(rcnt[i]):
                 flat = rev[i, r]
@@ -268,16 +270,16 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 v1[1] = vf[1]
             if fx & 4:
                 w1 = vf[2]
-        # energy at t_n with the mid-point velocities
+        # energy at t_n with the mid-point velocities: work of the damping, and of the
+        # constraint that imposes prescribed velocities (contact dissipation and the
+        # walls' work were booked in 1.)
         vm = 0.5 * (v0 + v1)
         wm = 0.5 * (w0 + w1)
         x0 = pos[i]
-        e = eacc[i]
-        edis = e[0] + a[3] + (alpha * (m * vm.dot(vm) + inertia * wm * wm)
-                              - fd.dot(vm) - md * wm) * dt
-        # work of the walls and of the constraint that imposes prescribed velocities
-        ework = e[1] + a[4] + m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm
-        eacc[i] = ti.Vector([edis, ework])
+        if alpha != 0.0 or alpha_l != 0.0 or fx != 0:
+            eacc[i] += ti.Vector([
+                (alpha * (m * vm.dot(vm) + inertia * wm * wm) - fd.dot(vm) - md * wm) * dt,
+                m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm])
         if ti.static(detail):
             force[i] = f
             torque[i] = tq
