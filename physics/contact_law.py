@@ -41,6 +41,20 @@ class ContactLaw:
         """Largest stiffness the law reaches for a particle of this radius (for Δt)."""
         raise NotImplementedError
 
+    def update(self, **params):
+        """Change parameters, validated as in the constructor (e.g.
+        ``law.update(friction=0.0)``). A simulation using the law takes the new values
+        at its next ``run``. Nothing changes if a value is bad."""
+        current = {k: v for k, v in self.to_dict().items() if k != "type"}
+        if self.rolling is not None:
+            current["rolling"] = self.rolling
+        unknown = set(params) - set(current) - {"rolling"}
+        if unknown:
+            raise InputError(f"{type(self).__name__} has no parameter {sorted(unknown)[0]!r}")
+        fresh = type(self)(**{**current, **params})
+        self.__dict__.update(fresh.__dict__)
+        return self
+
     def _set_common(self, friction, cohesion, restitution, damping_ratio, rolling):
         """Friction, cohesion and damping shared by every law, validated."""
         self.friction = non_negative("friction", friction)

@@ -754,6 +754,8 @@ class Simulation:
                              f"steps={steps!r}")
         if not self._built:
             self._build()
+        self._upload_laws()          # a law's parameters may have changed since (law.update)
+        self._crit_cache = None
         if self._dt_user is not None:
             self._check_dt_value(self._dt_user)  # particles or laws may have changed since
         self._upload_params()

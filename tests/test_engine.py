@@ -141,3 +141,24 @@ def test_device_side_rebuild_path_gives_the_same_run():
         runs.append((sim.particles.numpy()["position"], sim.neighbour_builds))
     assert runs[0][1] == runs[1][1] > 1
     assert np.array_equal(runs[0][0], runs[1][0])
+
+
+def test_law_update_takes_effect_at_the_next_run():
+    """A disc sliding on a floor: frictionless it keeps its speed; after
+    ``law.update(friction=0.3)`` it decelerates at μ g."""
+    law = tdem.LinearContact(kn=1e6, friction=0.0)
+    sim = tdem.Simulation(gravity=(0.0, -9.81), dt_fraction=0.1)
+    m = 1000.0 * np.pi * 0.01
+    sim.add_particles([[0.0, 0.1 - m * 9.81 / 1e6]], 0.1, density=1000.0, contact=law,
+                      velocity=[[2.0, 0.0]])
+    sim.add_wall((-10.0, 0.0), (10.0, 0.0), contact=law)
+    sim.run(until=0.1)
+    assert sim.particles.numpy()["velocity"][0, 0] == pytest.approx(2.0, rel=1e-6)
+    with pytest.raises(tdem.InputError, match="friction"):
+        law.update(friction=-1.0)
+    assert law.friction == 0.0
+    law.update(friction=0.3)
+    v0, t0 = sim.particles.numpy()["velocity"][0, 0], sim.time
+    sim.run(until=0.3)
+    v1 = sim.particles.numpy()["velocity"][0, 0]
+    assert (v0 - v1) / (sim.time - t0) == pytest.approx(0.3 * 9.81, rel=0.01)
