@@ -133,6 +133,57 @@ class Wall:
         r = self._row()
         return np.array([[r[stepk.W_X0], r[stepk.W_Y0]], [r[stepk.W_X1], r[stepk.W_Y1]]])
 
+    def servo(self, force=None, stress=None, direction=None, relaxation=0.5, max_speed=None):
+        """Drive this wall so that it receives ``force`` (N per metre of thickness,
+        compression-positive) — or ``stress`` × its length — along ``direction`` (the unit
+        direction in which it moves to compress; default: its normal pointing to the
+        particles that touch it, else to the left of p0→p1). The speed is set every step
+        on the device from the force received, with a gain from the contact stiffness
+        (relaxation in (0, 1]); ``max_speed`` caps it (default: 0.01 × the smallest radius
+        per step). ``wall.servo()`` switches the control off and stops the wall."""
+        sim = self._sim
+        row = self._row()
+        if force is None and stress is None:
+            self._set([stepk.W_SERVO_K, stepk.W_VX, stepk.W_VY], [0.0, 0.0, 0.0])
+            return self
+        if (force is None) == (stress is None):
+            raise InputError(f"give force or stress, not both: force={force!r}, stress={stress!r}")
+        a, b = self.endpoints
+        length = float(np.linalg.norm(b - a))
+        target = float(force) if force is not None else float(stress) * length
+        if not math.isfinite(target):
+            raise InputError(f"force must be finite, got {target!r}")
+        if direction is None:
+            t = (b - a) / length
+            d = np.array([-t[1], t[0]])
+            x = sim.particles.numpy(stress=False)["position"] if sim.n_particles else None
+            if x is not None and len(x):
+                mid = 0.5 * (a + b)
+                if np.dot(x.mean(axis=0) - mid, d) < 0:
+                    d = -d
+        else:
+            d = _vector2("direction", direction)
+            if np.linalg.norm(d) == 0:
+                raise InputError(f"direction must not be zero, got {direction!r}")
+            d = d / np.linalg.norm(d)
+        relaxation = float(relaxation)
+        if not 0.0 < relaxation <= 1.0:
+            raise InputError(f"relaxation must lie in (0, 1], got {relaxation!r}")
+        law = sim._laws[int(row[stepk.W_LAW])]
+        r = sim._radii()
+        rmean = float(r.mean()) if len(r) else 1.0
+        k = law.critical_stiffness(rmean, 1.0)
+        dt = sim.dt
+        if max_speed is None:
+            max_speed = 0.01 * float(r.min() if len(r) else 1.0) / dt
+        max_speed = float(max_speed)
+        if not (max_speed > 0 and math.isfinite(max_speed)):
+            raise InputError(f"max_speed must be a positive number, got {max_speed!r}")
+        self._set([stepk.W_SERVO_K, stepk.W_SERVO_F, stepk.W_SERVO_DX, stepk.W_SERVO_DY,
+                   stepk.W_SERVO_ALPHA, stepk.W_SERVO_VMAX, stepk.W_OMEGA],
+                  [k, target, d[0], d[1], relaxation, max_speed, 0.0])
+        return self
+
     @property
     def force(self):
         """Total contact force (2,) this wall received in the last step."""
@@ -468,7 +519,7 @@ class Simulation:
         for k, spec in _WSLOTS.items():
             a[k] = self._alloc(spec, (n, capw))
         a["wall"] = ti.ndarray(ti.f64, (max(nwalls, 1), stepk.WALL_WIDTH))
-        a["wforce"] = ti.Vector.ndarray(3, ti.f64, (max(nwalls, 1),))
+        a["wforce"] = ti.Vector.ndarray(4, ti.f64, (max(nwalls, 1),))  # fx, fy, moment, contacts
         a["lawp"] = ti.ndarray(ti.f64, (nlaws, LAW_WIDTH))
         a["lawpair"] = ti.ndarray(ti.i32, (nlaws, nlaws))
         a["flags"] = ti.ndarray(ti.i32, (FLAGS_SIZE,))
@@ -598,7 +649,7 @@ class Simulation:
 
     def _wall_loads(self):
         if not self._built:
-            return np.zeros((len(self._walls_host), 3))
+            return np.zeros((len(self._walls_host), 4))
         return self._a["wforce"].to_numpy()[:len(self._walls_host)]
 
     def _grid_cells_for(self, pos, radius):

@@ -23,9 +23,12 @@ from .neighbors import F_BAD, F_REBUILD, slot_bits
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
 SIMP_SIZE = 8
 # columns of the wall array: p0, p1, translation velocity, angular velocity, centre, law
-# W_INVLL = 1/|p1 − p0|²; W_DISP = largest displacement of the wall since the lists were built
-W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW, W_INVLL, W_DISP = range(12)
-WALL_WIDTH = 12
+# W_INVLL = 1/|p1 − p0|²; W_DISP = largest displacement of the wall since the lists were built;
+# servo control: W_SERVO_K > 0 switches it on (stiffness of one contact), target force
+# W_SERVO_F along the unit direction (W_SERVO_DX, W_SERVO_DY), relaxation, speed limit
+(W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW, W_INVLL, W_DISP,
+ W_SERVO_K, W_SERVO_F, W_SERVO_DX, W_SERVO_DY, W_SERVO_ALPHA, W_SERVO_VMAX) = range(18)
+WALL_WIDTH = 18
 # fixed-velocity bits
 FIX_VX, FIX_VY, FIX_W = 1, 2, 4
 
@@ -156,11 +159,28 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             ti.atomic_add(wforce[w][0], -f[0])
             ti.atomic_add(wforce[w][1], -f[1])
             ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
+            ti.atomic_add(wforce[w][3], 1.0)
         elif whist[i, s][0] != 0.0 or wcs[i, s][2] > 0.0 or whist[i, s][1] != 0.0:
             whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
             wcs[i, s] = ti.Vector([0.0, 0.0, ri - ti.sqrt(d2)])
     return ftot, mtot, diss, work
+
+
+@ti.func
+def servo_velocity(wall: ti.template(), wforce: ti.template(), w, dt):
+    """Velocity of a servo-controlled wall (PFC-style): it moves along its direction d
+    by relaxation × (target − measured force)/(contacts × k) per step, so that with
+    relaxation < 1 the force converges without overshoot; |v| <= the speed limit.
+    The measured force is the compression the wall receives along −d."""
+    d = ti.Vector([wall[w, W_SERVO_DX], wall[w, W_SERVO_DY]])
+    fw = wforce[w]
+    measured = -(fw[0] * d[0] + fw[1] * d[1])
+    k = wall[w, W_SERVO_K] * ti.max(fw[3], 1.0)
+    v = wall[w, W_SERVO_ALPHA] * (wall[w, W_SERVO_F] - measured) / (k * dt)
+    vmax = wall[w, W_SERVO_VMAX]
+    v = ti.math.clamp(v, -vmax, vmax)
+    return v * d[0], v * d[1]
 
 
 @ti.kernel
@@ -193,7 +213,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
 
     ti.loop_config(serialize=True)
     for w in range(nw):
-        wforce[w] = ti.Vector([0.0, 0.0, 0.0])
+        wforce[w] = ti.Vector([0.0, 0.0, 0.0, 0.0])
 
     # 1. contact forces at x_n: each pair once, by its owner (the lower index). On one
     #    thread the partner's share goes straight into its sum; in parallel it is kept
@@ -293,10 +313,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         if dx.dot(dx) > half_skin2:
             flags[F_REBUILD] = 1
 
-    # 3. walls move: rotation about their centre, then translation; a wall that has
-    #    moved half the skin since the lists were built asks for a rebuild
+    # 3. walls move: servo walls first set their speed from the force they received,
+    #    then rotation about their centre and translation; a wall that has moved half
+    #    the skin since the lists were built asks for a rebuild
     ti.loop_config(serialize=True)
     for w in range(nw):
+        if wall[w, W_SERVO_K] > 0.0:
+            wall[w, W_VX], wall[w, W_VY] = servo_velocity(wall, wforce, w, dt)
         c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
         v = ti.Vector([wall[w, W_VX], wall[w, W_VY]])
         ang = wall[w, W_OMEGA] * dt
