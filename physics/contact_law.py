@@ -38,7 +38,8 @@ class ContactLaw:
         raise NotImplementedError
 
     def critical_stiffness(self, radius, mass):
-        """Largest stiffness the law reaches for a particle of this radius (for Δt)."""
+        """Largest stiffness the law reaches for particles of this radius and mass
+        (numbers or numpy arrays), for the critical time step."""
         raise NotImplementedError
 
     def update(self, **params):

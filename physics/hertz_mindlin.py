@@ -12,6 +12,7 @@ forms, which go with the 4/3 prefactor. The sphere formula is used for discs, as
 2D DEM codes commonly do. A restitution coefficient sets a normal dashpot with
 Miyata Eq. 17 evaluated with the current tangent stiffness.
 """
+import numpy as np
 
 from .contact_law import HERTZ, ContactLaw
 from .validate import in_range, positive
@@ -41,5 +42,5 @@ class HertzMindlin(ContactLaw):
 
     def critical_stiffness(self, radius, mass):
         """Tangent stiffness at an overlap of 5 % of the radius (a conservative bound)."""
-        a = (radius * 0.5 * 0.05 * radius) ** 0.5
-        return max(2.0 * self.e_star * a, 8.0 * self.g_star * a)
+        a = (0.5 * 0.05) ** 0.5 * np.asarray(radius, dtype=float)   # sqrt(R* u), R* = R/2
+        return np.maximum(2.0 * self.e_star * a, 8.0 * self.g_star * a)

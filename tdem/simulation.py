@@ -487,8 +487,7 @@ class Simulation:
             k = np.zeros(int(sel.sum()))
             for u in used:
                 law = self._laws[u]
-                k = np.maximum(k, [law.critical_stiffness(ri, mi)
-                                   for ri, mi in zip(r[sel], m[sel])])
+                k = np.maximum(k, law.critical_stiffness(r[sel], m[sel]))
             crit = min(crit, float(np.min(2.0 * np.sqrt(m[sel] / k))))
         return crit
 
