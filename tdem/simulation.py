@@ -693,15 +693,16 @@ class Simulation:
         self._last_fit = self._steps
 
     def _apply_fixes(self, initial=False, t=None):
+        """Upload prescribed velocities: all of them (``initial``), else only the values
+        of the functions of time, evaluated at ``t``. The host keeps its own copy, so a
+        step reads nothing back from the device."""
         if not self._fixes:
             return
         t = self._time if t is None else t
         if initial:
             fix = np.zeros(self._n, np.int32)
-            vfix = self._a["vfix"].to_numpy()
-        else:
-            fix = None
-            vfix = self._a["vfix"].to_numpy()
+            self._vfix_host = np.zeros((self._n, 3))
+        vfix = self._vfix_host
         any_fn = False
         for ids, *vals in self._fixes:
             for bit, col, v in zip((1, 2, 4), range(3), vals):

@@ -162,3 +162,17 @@ def test_law_update_takes_effect_at_the_next_run():
     sim.run(until=0.3)
     v1 = sim.particles.numpy()["velocity"][0, 0]
     assert (v0 - v1) / (sim.time - t0) == pytest.approx(0.3 * 9.81, rel=0.01)
+
+
+def test_prescribed_velocity_as_a_function_of_time():
+    """vx = 2t prescribed: x = t² (the leapfrog with v evaluated at the step's start)."""
+    sim = tdem.Simulation(gravity=(0.0, -9.81), dt=1e-3)
+    g = sim.add_particles([[0.0, 0.0]], 0.1, density=1000.0, contact=tdem.LinearContact(kn=1e6))
+    sim.fix_particles(g.ids, vx=lambda t: 2.0 * t, vy=0.0)
+    sim.run(until=0.5)
+    p = sim.particles.numpy()
+    n = sim.steps
+    assert p["position"][0, 0] == pytest.approx(sum(2.0 * k * 1e-3 for k in range(n)) * 1e-3,
+                                                rel=1e-12)
+    assert p["position"][0, 1] == 0.0
+    assert p["velocity"][0, 0] == pytest.approx(2.0 * (n - 1) * 1e-3, rel=1e-12)
