@@ -48,10 +48,6 @@ def init(arch=None, threads=None):
     return actual
 
 
-def current_arch():
-    return _state["arch"]
-
-
 def serial_loops():
     """True when parallel-for dispatch costs more than it gains (one CPU thread)."""
     return _state["arch"] == "cpu" and _state["threads"] == 1
