@@ -69,6 +69,8 @@ import taichi as ti
 from tdem import backend
 from tdem.errors import CapacityError, InputError
 
+from . import fvm
+from .materials import mc_correct_state
 from .validate import positive
 
 MAX_ELEMENTS = 12        # elements a particle can create (pruned gaps are >= 30 deg)
@@ -103,6 +105,123 @@ def _angle_ok(p, q, r):
     u = q - p
     v = r - p
     return ti.abs(u.dot(v)) <= COS_30 * ti.sqrt(u.dot(u) * v.dot(v))
+
+
+@ti.func
+def _ring(i, xi, m, pos: ti.template(), nbr: ti.template(), ring: ti.template(),
+          ring_ang: ti.template()):
+    """Counter-clockwise ring of the m neighbours nbr[i, :m] of particle i (at xi),
+    angularly pruned (module docstring); returns the number left in ring[i, :]."""
+    # counter-clockwise ring: insertion sort by (angle, index)
+    for a in range(m):
+        j = nbr[i, a]
+        d = pos[j] - xi
+        ang = ti.math.atan2(d[1], d[0])
+        b = a
+        while b > 0 and ring_ang[i, b - 1] > ang:
+            ring[i, b] = ring[i, b - 1]
+            ring_ang[i, b] = ring_ang[i, b - 1]
+            b -= 1
+        ring[i, b] = j
+        ring_ang[i, b] = ang
+    # angular pruning: drop the farther of the closest adjacent pair while < 30 deg
+    while m >= 2:
+        kmin = 0
+        gmin = 1e300
+        for k in range(m):
+            g = 0.0
+            if k + 1 < m:
+                g = ring_ang[i, k + 1] - ring_ang[i, k]
+            else:
+                g = ring_ang[i, 0] + 2.0 * math.pi - ring_ang[i, k]
+            if g < gmin:
+                gmin = g
+                kmin = k
+        if gmin >= MIN_GAP:
+            break
+        k1 = (kmin + 1) % m
+        ja = ring[i, kmin]
+        jb = ring[i, k1]
+        da = pos[ja] - xi
+        db = pos[jb] - xi
+        qa = da.dot(da)
+        qb = db.dot(db)
+        drop = kmin
+        if qb > qa or (qb == qa and jb > ja):
+            drop = k1
+        for k in range(drop, m - 1):
+            ring[i, k] = ring[i, k + 1]
+            ring_ang[i, k] = ring_ang[i, k + 1]
+        m -= 1
+    return m
+
+
+@ti.func
+def _create(a, m, xa, ra, tol, pos: ti.template(), rad: ti.template(), ring: ti.template(),
+            elem: ti.template(), earea: ti.template()):
+    """Elements of particle a (at xa, radius ra) from its ring of m neighbours, by the
+    creation rules; stored in elem[a, :], earea[a, :]; returns their number."""
+    cnt = 0
+    if m >= 2:
+        for k in range(m):
+            b = ring[a, k]
+            c = ring[a, (k + 1) % m]
+            xb = pos[b]
+            xc = pos[c]
+            rb = rad[b]
+            rc = rad[c]
+            twice = _orient(xa, xb, xc)
+            ab = xb - xa
+            bc = xc - xb
+            ca = xa - xc
+            lab = ab.dot(ab)
+            lbc = bc.dot(bc)
+            lca = ca.dot(ca)
+            cab = ra + rb + tol
+            cbc = rb + rc + tol
+            cca = rc + ra + tol
+            emin = 0.5 * (ra + rb + rc) / 3.0
+            ok = twice > 0.0
+            ok = ok and lab <= cab * cab and lbc <= cbc * cbc and lca <= cca * cca
+            ok = ok and lab >= emin * emin and lbc >= emin * emin and lca >= emin * emin
+            ok = ok and _angle_ok(xa, xb, xc) and _angle_ok(xb, xc, xa) and _angle_ok(
+                xc, xa, xb)
+            if ok and cnt < MAX_ELEMENTS:
+                elem[a, cnt, 0] = b
+                elem[a, cnt, 1] = c
+                earea[a, cnt] = 0.5 * twice
+                cnt += 1
+    return cnt
+
+
+@ti.func
+def _cover(v0, v1, v2, pos: ti.template(), nbr: ti.template(), nbr_cnt: ti.template(),
+           elem: ti.template(), ecnt: ti.template()):
+    """N_e of the element with vertices v0 < v1 < v2: how many elements (copies
+    included) strictly contain its probe point."""
+    p = PROBE[0] * pos[v0] + PROBE[1] * pos[v1] + PROBE[2] * pos[v2]
+    verts = ti.Vector([v0, v1, v2])
+    count = 0
+    for t in ti.static(range(3)):
+        v = verts[t]
+        for q in range(nbr_cnt[v] + 1):
+            o = v
+            if q > 0:
+                o = nbr[v, q - 1]
+            xo = pos[o]
+            for s2 in range(ecnt[o]):
+                e1 = elem[o, s2, 0]
+                e2 = elem[o, s2, 1]
+                take = _has(o, e1, e2, v)
+                for u in ti.static(range(t)):
+                    take = take and not _has(o, e1, e2, verts[u])
+                if take:
+                    x1 = pos[e1]
+                    x2 = pos[e2]
+                    if _orient(xo, x1, p) > 0.0 and _orient(x1, x2, p) > 0.0 and \
+                            _orient(x2, xo, p) > 0.0:
+                        count += 1
+    return count
 
 
 @ti.kernel
@@ -200,47 +319,7 @@ def find_neighbours(pos: ti.types.ndarray(), rad: ti.types.ndarray(), tol: ti.f6
         nbr_cnt[i] = m
         for k in range(m, cap):
             nbr[i, k] = -1
-        # counter-clockwise ring: insertion sort by (angle, index)
-        for a in range(m):
-            j = nbr[i, a]
-            d = pos[j] - xi
-            ang = ti.math.atan2(d[1], d[0])
-            b = a
-            while b > 0 and ring_ang[i, b - 1] > ang:
-                ring[i, b] = ring[i, b - 1]
-                ring_ang[i, b] = ring_ang[i, b - 1]
-                b -= 1
-            ring[i, b] = j
-            ring_ang[i, b] = ang
-        # angular pruning: drop the farther of the closest adjacent pair while < 30 deg
-        while m >= 2:
-            kmin = 0
-            gmin = 1e300
-            for k in range(m):
-                g = 0.0
-                if k + 1 < m:
-                    g = ring_ang[i, k + 1] - ring_ang[i, k]
-                else:
-                    g = ring_ang[i, 0] + 2.0 * math.pi - ring_ang[i, k]
-                if g < gmin:
-                    gmin = g
-                    kmin = k
-            if gmin >= MIN_GAP:
-                break
-            k1 = (kmin + 1) % m
-            ja = ring[i, kmin]
-            jb = ring[i, k1]
-            da = pos[ja] - xi
-            db = pos[jb] - xi
-            qa = da.dot(da)
-            qb = db.dot(db)
-            drop = kmin
-            if qb > qa or (qb == qa and jb > ja):
-                drop = k1
-            for k in range(drop, m - 1):
-                ring[i, k] = ring[i, k + 1]
-                ring_ang[i, k] = ring_ang[i, k + 1]
-            m -= 1
+        m = _ring(i, xi, m, pos, nbr, ring, ring_ang)
         ring_cnt[i] = m
         for k in range(m, cap):
             ring[i, k] = -1
@@ -255,39 +334,7 @@ def create_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(), tol: ti.f6
     rules: elem[A, s, 0:2] = (i, i+1), earea[A, s] = area S_e, s < ecnt[A]."""
     n = pos.shape[0]
     for a in range(n):
-        m = ring_cnt[a]
-        cnt = 0
-        if m >= 2:
-            xa = pos[a]
-            ra = rad[a]
-            for k in range(m):
-                b = ring[a, k]
-                c = ring[a, (k + 1) % m]
-                xb = pos[b]
-                xc = pos[c]
-                rb = rad[b]
-                rc = rad[c]
-                twice = _orient(xa, xb, xc)
-                ab = xb - xa
-                bc = xc - xb
-                ca = xa - xc
-                lab = ab.dot(ab)
-                lbc = bc.dot(bc)
-                lca = ca.dot(ca)
-                cab = ra + rb + tol
-                cbc = rb + rc + tol
-                cca = rc + ra + tol
-                emin = 0.5 * (ra + rb + rc) / 3.0
-                ok = twice > 0.0
-                ok = ok and lab <= cab * cab and lbc <= cbc * cbc and lca <= cca * cca
-                ok = ok and lab >= emin * emin and lbc >= emin * emin and lca >= emin * emin
-                ok = ok and _angle_ok(xa, xb, xc) and _angle_ok(xb, xc, xa) and _angle_ok(
-                    xc, xa, xb)
-                if ok and cnt < MAX_ELEMENTS:
-                    elem[a, cnt, 0] = b
-                    elem[a, cnt, 1] = c
-                    earea[a, cnt] = 0.5 * twice
-                    cnt += 1
+        cnt = _create(a, ring_cnt[a], pos[a], rad[a], tol, pos, rad, ring, elem, earea)
         ecnt[a] = cnt
         for s in range(cnt, MAX_ELEMENTS):
             elem[a, s, 0] = -1
@@ -318,28 +365,7 @@ def count_cover(pos: ti.types.ndarray(), nbr: ti.types.ndarray(), nbr_cnt: ti.ty
                 v1, v2 = v2, v1
             if v0 > v1:
                 v0, v1 = v1, v0
-            p = PROBE[0] * pos[v0] + PROBE[1] * pos[v1] + PROBE[2] * pos[v2]
-            verts = ti.Vector([v0, v1, v2])
-            count = 0
-            for t in ti.static(range(3)):
-                v = verts[t]
-                for q in range(nbr_cnt[v] + 1):
-                    o = v
-                    if q > 0:
-                        o = nbr[v, q - 1]
-                    xo = pos[o]
-                    for s2 in range(ecnt[o]):
-                        e1 = elem[o, s2, 0]
-                        e2 = elem[o, s2, 1]
-                        take = _has(o, e1, e2, v)
-                        for u in ti.static(range(t)):
-                            take = take and not _has(o, e1, e2, verts[u])
-                        if take:
-                            x1 = pos[e1]
-                            x2 = pos[e2]
-                            if _orient(xo, x1, p) > 0.0 and _orient(x1, x2, p) > 0.0 and \
-                                    _orient(x2, xo, p) > 0.0:
-                                count += 1
+            count = _cover(v0, v1, v2, pos, nbr, nbr_cnt, elem, ecnt)
             ncover[a, s] = count
         for s in range(ecnt[a], MAX_ELEMENTS):
             ncover[a, s] = 0
@@ -597,3 +623,228 @@ def check_rules(positions, radii, tolerance, triangles, rtol=1e-9):
     ok = contact & edge & orientation & angle
     return {"orientation": orientation, "contact": contact, "angle": angle, "edge": edge,
             "ok": ok}
+
+
+# ------------------------------------------------------- coupled to the time step
+# The kernels below run inside :class:`tdem.Simulation`'s step (spec §3 order):
+# :func:`candidates` after each neighbour-list build, :func:`update` every step
+# before the contact forces. Particles of one PCMM body share a material slot
+# ``pmat[i] >= 0`` (−1: a plain DEM disc); elements join particles of one slot only.
+
+# indices in the int status array ``pflags``
+P_NEED = 0       # largest number of Eq. 1 candidates of any particle
+P_BUILDS = 1     # engine list build the candidates were made from (−1: none yet)
+PFLAGS_SIZE = 4
+
+
+@ti.kernel
+def candidates(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
+               mtol: ti.types.ndarray(), cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
+               cell_count: ti.types.ndarray(), cell_start: ti.types.ndarray(),
+               sorted_ids: ti.types.ndarray(), gridp: ti.types.ndarray(),
+               gridn: ti.types.ndarray(), flags: ti.types.ndarray(),
+               pflags: ti.types.ndarray(), builds: ti.i32, skin: ti.f64, reach: ti.i32):
+    """Verlet candidates of Eq. 1: every j of the same body with
+    d_ij < R_i + R_j + δ + skin, sorted by index, from the engine's cell grid.
+
+    Runs only when the engine has rebuilt its lists since the candidates were made
+    (``flags[builds] != pflags[P_BUILDS]``): between builds no particle moves more
+    than half the skin, so every pair within the Eq. 1 distance stays listed.
+    ``reach``: how many cells to search on each side (the Eq. 1 cut-off plus the
+    skin can exceed the engine's cell side).
+    """
+    n = pos.shape[0]
+    cap = cand.shape[1]
+    nx = gridn[0]
+    ny = gridn[1]
+    for i in range(n):
+        if flags[builds] != pflags[P_BUILDS] and pmat[i] >= 0:
+            m = pmat[i]
+            xi = pos[i]
+            ri = rad[i]
+            cx = ti.math.clamp(ti.cast(ti.floor((xi[0] - gridp[0]) / gridp[2]), ti.i32), 0, nx - 1)
+            cy = ti.math.clamp(ti.cast(ti.floor((xi[1] - gridp[1]) / gridp[2]), ti.i32), 0, ny - 1)
+            cnt = 0
+            for ccy in range(ti.max(cy - reach, 0), ti.min(cy + reach + 1, ny)):
+                for ccx in range(ti.max(cx - reach, 0), ti.min(cx + reach + 1, nx)):
+                    c = ccy * nx + ccx
+                    for s in range(cell_start[c], cell_start[c] + cell_count[c]):
+                        j = sorted_ids[s]
+                        if j != i and pmat[j] == m:
+                            d = pos[j] - xi
+                            cut = ri + rad[j] + mtol[m] + skin
+                            if d.dot(d) < cut * cut:
+                                if cnt < cap:
+                                    k = cnt
+                                    while k > 0 and cand[i, k - 1] > j:
+                                        cand[i, k] = cand[i, k - 1]
+                                        k -= 1
+                                    cand[i, k] = j
+                                cnt += 1
+            ccnt[i] = ti.min(cnt, cap)
+            ti.atomic_max(pflags[P_NEED], cnt)
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        pflags[P_BUILDS] = flags[builds]
+
+
+@ti.func
+def _corner(o, e1, e2, i):
+    """Which vertex of the element (o, e1, e2) particle i is (0, 1, 2), −1 if none."""
+    c = -1
+    if o == i:
+        c = 0
+    elif e1 == i:
+        c = 1
+    elif e2 == i:
+        c = 2
+    return c
+
+
+@ti.kernel
+def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarray(),
+           pmat: ti.types.ndarray(), matp: ti.types.ndarray(), mtol: ti.types.ndarray(),
+           cand: ti.types.ndarray(), ccnt: ti.types.ndarray(), nbr: ti.types.ndarray(),
+           ncnt: ti.types.ndarray(), ring: ti.types.ndarray(), rang: ti.types.ndarray(),
+           elem: ti.types.ndarray(), ecnt: ti.types.ndarray(), earea: ti.types.ndarray(),
+           ncov: ti.types.ndarray(), esig: ti.types.ndarray(), efor: ti.types.ndarray(),
+           ede: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
+           pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), enbr: ti.types.ndarray(),
+           encnt: ti.types.ndarray(), cskip: ti.types.ndarray(), dt: ti.f64,
+           serial: ti.template()):
+    """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16), for the particles of x_n
+    moving at v_{n−1/2}:
+
+    1. per particle: Eq. 1 neighbours from the candidates, pruned ring, elements
+       (the element set the rules give now: deleted and created in one go);
+    2. per element: N_e (probe rule), σ_old = mean of its particles' stresses,
+       Eqs. 6–11 with the Jaumann rotation, the constitutive correction (Eq. 12),
+       nodal forces with the weight 1/N_e (Eqs. 13–14, sign fixed);
+    3. per particle (gathered, no atomics): force of its elements → xforce,
+       stress = mean of its elements' σ (zero in none), strain and plastic shear
+       strain += the means of the increments; the engine's pair slots of particles
+       that share an element are marked in ``cskip`` (no DEM contact between them).
+
+    pstate[i] = (plastic shear strain, failed (0/1), elements containing i, −).
+    """
+    n = pos.shape[0]
+    # 1. neighbours, ring, elements
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        m = pmat[i]
+        cnt = 0
+        if m >= 0:
+            xi = pos[i]
+            ri = rad[i]
+            tol = mtol[m]
+            for q in range(ccnt[i]):
+                j = cand[i, q]
+                d = pos[j] - xi
+                cut = ri + rad[j] + tol
+                if d.dot(d) <= cut * cut:
+                    nbr[i, cnt] = j
+                    cnt += 1
+            ncnt[i] = cnt
+            r = _ring(i, xi, cnt, pos, nbr, ring, rang)
+            ecnt[i] = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
+        else:
+            ncnt[i] = 0
+            ecnt[i] = 0
+    # 2. element stresses and nodal forces
+    ti.loop_config(serialize=serial)
+    for a in range(n):
+        for s in range(ecnt[a]):
+            b = elem[a, s, 0]
+            c = elem[a, s, 1]
+            v0, v1, v2 = a, b, c
+            if v0 > v1:
+                v0, v1 = v1, v0
+            if v1 > v2:
+                v1, v2 = v2, v1
+            if v0 > v1:
+                v0, v1 = v1, v0
+            cover = _cover(v0, v1, v2, pos, nbr, ncnt, elem, ecnt)
+            ncov[a, s] = cover
+            xa, xb, xc = pos[a], pos[b], pos[c]
+            grad = fvm.velocity_gradient(xa, xb, xc, vel[a], vel[b], vel[c])
+            de = fvm.strain_increment(grad, dt)
+            M = pmat[a]
+            sig = (psig[a] + psig[b] + psig[c]) / 3.0
+            sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+                de, matp[M, 2], matp[M, 3])
+            failed = 0
+            if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
+                failed = 1
+            sig, eps, flag = mc_correct_state(sig, matp, M, failed)
+            esig[a, s] = sig
+            ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64)])
+            sf = sig + viscous_stress(matp, M, de, dt)
+            fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
+            efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+    # 3. gather per particle
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        for k in range(encnt[i]):
+            cskip[i, k] = 0
+        if pmat[i] >= 0:
+            f = ti.Vector([0.0, 0.0])
+            ssum = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            dsum = ti.Vector([0.0, 0.0, 0.0])
+            psum = 0.0
+            hit = 0
+            cnt = 0
+            for q in range(ncnt[i] + 1):
+                o = i
+                if q > 0:
+                    o = nbr[i, q - 1]
+                for s in range(ecnt[o]):
+                    e1 = elem[o, s, 0]
+                    e2 = elem[o, s, 1]
+                    c = _corner(o, e1, e2, i)
+                    if c >= 0:
+                        fo = efor[o, s]
+                        f += ti.Vector([fo[2 * c], fo[2 * c + 1]])
+                        ssum += esig[o, s]
+                        d = ede[o, s]
+                        dsum += ti.Vector([d[0], d[1], d[2]])
+                        psum += d[3]
+                        if d[4] > 0.0:
+                            hit = 1
+                        cnt += 1
+                        # mark the engine slots of i's partners in this element
+                        for t in ti.static(range(3)):
+                            u = o
+                            if ti.static(t == 1):
+                                u = e1
+                            if ti.static(t == 2):
+                                u = e2
+                            if u > i:
+                                for k in range(encnt[i]):
+                                    if enbr[i, k] == u:
+                                        cskip[i, k] = 1
+            xforce[i] = f
+            st = pstate[i]
+            if cnt > 0:
+                inv = 1.0 / cnt
+                psig[i] = ssum * inv
+                peps[i] += dsum * inv
+                st[0] += psum * inv
+            else:
+                psig[i] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            if hit == 1:
+                st[1] = 1.0
+            st[2] = ti.cast(cnt, ti.f64)
+            pstate[i] = st
+
+
+@ti.func
+def viscous_stress(matp: ti.template(), M, de, dt):
+    """Viscous stress 2μ·dev(D) of a Fluid row (μ in column 11), D = Δε/Δt in plane
+    strain (D_zz = 0); zero for other materials. Not accumulated: it acts on the
+    forces of the step only."""
+    mu = matp[M, 11]
+    out = ti.Vector([0.0, 0.0, 0.0, 0.0])
+    if mu > 0.0:
+        tr = (de[0] + de[1]) / 3.0
+        out = 2.0 * mu / dt * ti.Vector([de[0] - tr, de[1] - tr, de[2], -tr])
+    return out

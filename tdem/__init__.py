@@ -11,10 +11,10 @@ from physics.materials import Elastic, Fluid, MohrCoulomb
 
 from . import mesh, pack
 from .errors import CapacityError, InputError, InstabilityError
-from .simulation import ParticleGroup, Simulation, Wall
+from .simulation import Block, ParticleGroup, Simulation, Wall
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "ParticleGroup", "Wall", "LinearContact", "HertzMindlin",
+__all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "LinearContact", "HertzMindlin",
            "RollingResistance", "Elastic", "MohrCoulomb", "Fluid", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack"]

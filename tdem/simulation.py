@@ -19,10 +19,14 @@ import numpy as np
 import taichi as ti
 
 from physics.contact_law import LAW_WIDTH, ContactLaw
+from physics.linear import LinearContact
+from physics.materials import Material, MohrCoulomb
 
 from . import backend, neighbors
+from . import mesh as _mesh
 from . import snapshot
 from . import step as stepk
+from .continuum import Continuum
 from .errors import CapacityError, InputError, InstabilityError
 from .neighbors import F_BAD, F_BUILDS, F_NEED, F_REBUILD, F_WALL_NEED, FLAGS_SIZE
 
@@ -34,12 +38,12 @@ _PARTICLE = {
     "force": 2, "torque": 0, "xref": 2, "pos0": 2, "facc": 3, "eacc": 2, "estate": 2,
 }
 _SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
-          "nbr_old": "i", "hist_old": 4}
+          "nbr_old": "i", "hist_old": 4, "cskip": "i"}
 _COUNTS = ("ncnt", "rcnt", "ncnt_old")
 _WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3, "wid_old": "i", "whist_old": 4}
 # arrays rebuilt from scratch whenever needed (never saved or restored)
 _SCRATCH = ("stress_out", "cell_count", "cell_start", "sorted", "pcell", "bounds", "nbr_old", "hist_old",
-            "ncnt_old", "simp", "lawp", "lawpair", "facc", "wid_old", "whist_old")
+            "ncnt_old", "simp", "lawp", "lawpair", "facc", "wid_old", "whist_old", "cskip")
 
 
 def _vector2(name, value):
@@ -84,6 +88,84 @@ class ParticleGroup:
 
     def __repr__(self):
         return f"ParticleGroup({len(self.ids)} particles, ids {self.ids[0]}..{self.ids[-1]})"
+
+
+class Block:
+    """A deformable block: a triangle mesh with fixed connectivity (spec §4), made by
+    :meth:`Simulation.add_block`. Its nodes carry lumped masses ρ·S/3; its
+    triangles the stress (same FVM update as the PCMM elements, weight 1)."""
+
+    def __init__(self, sim, index, vertices, triangles, material, slot, velocity):
+        self._sim = sim
+        self.index = index
+        self.vertices = vertices
+        self.triangles = triangles
+        self.material = material
+        self.slot = slot
+        self.velocity = velocity
+        self._fixes = []
+        self._offset = 0
+
+    def __len__(self):
+        return len(self.vertices)
+
+    def __repr__(self):
+        return (f"Block({len(self.vertices)} nodes, {len(self.triangles)} triangles, "
+                f"{self.material!r})")
+
+    def fix(self, nodes, vx=0.0, vy=None):
+        """Prescribe velocity components of ``nodes`` (indices into the block's
+        vertices): each of vx, vy is None (free), a float, an array (one per node)
+        or a function of time returning either."""
+        ids = np.atleast_1d(np.asarray(nodes, dtype=np.int64))
+        nv = len(self.vertices)
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= nv:
+            raise InputError(f"nodes must be vertex indices of the block in [0, {nv}), got "
+                             f"{ids.tolist()[:8]}")
+        vals = [_fix_value(name, v, ids) for name, v in (("vx", vx), ("vy", vy))]
+        self._fixes.append((ids, *vals))
+        cont = self._sim._cont
+        if cont is not None:
+            cont.apply_node_fixes(self._sim.time, initial=True)
+
+    def nodes(self):
+        """Node state now, a dict of numpy arrays: position, velocity, force (of the
+        elements and contacts), reaction (of the prescribed velocities), mass,
+        displacement."""
+        if self._sim._cont is None:
+            x = self.vertices
+            z = np.zeros_like(x)
+            return {"position": x.copy(), "velocity": np.broadcast_to(self.velocity, x.shape).copy(),
+                    "force": z.copy(), "reaction": z.copy(),
+                    "mass": _mesh.nodal_masses(x, self.triangles, self.material.density),
+                    "displacement": z.copy()}
+        return self._sim._cont.block_nodes(self)
+
+    def elements(self):
+        """Triangles now: triangles (T, 3), stress (T, 2, 2), stress_zz, plastic_strain,
+        failed."""
+        self._sim._require_built()
+        return self._sim._cont.block_elements(self)
+
+    def nodes_in(self, xmin=-np.inf, xmax=np.inf, ymin=-np.inf, ymax=np.inf):
+        """Indices of the vertices (initial positions) inside the box."""
+        return _in_box(self.vertices, xmin, xmax, ymin, ymax)
+
+
+def _in_box(x, xmin, xmax, ymin, ymax):
+    return np.flatnonzero((x[:, 0] >= xmin) & (x[:, 0] <= xmax) &
+                          (x[:, 1] >= ymin) & (x[:, 1] <= ymax))
+
+
+def _fix_value(name, v, ids):
+    if v is None or callable(v):
+        return v
+    a = np.broadcast_to(np.asarray(v, dtype=float), ids.shape).copy() \
+        if np.ndim(v) <= 1 and (np.ndim(v) == 0 or len(v) == len(ids)) else None
+    if a is None or not np.isfinite(a).all():
+        raise InputError(f"{name} must be None, a finite number, {len(ids)} numbers "
+                         f"or a function of time, got {v!r}")
+    return a
 
 
 class Wall:
@@ -264,7 +346,10 @@ class Simulation:
         self._laws = []            # ContactLaw objects, index = law id
         self._pair_override = {}   # (law a, law b) -> law id
         self._groups = []
-        self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law")}
+        self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat")}
+        self._slots = []           # (material, tolerance) of PCMM bodies and blocks
+        self._blocks = []
+        self._cont = None          # Continuum (PCMM elements, blocks) once built
         self._walls_host = []      # rows of the wall table
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
@@ -287,7 +372,8 @@ class Simulation:
             self._dt_user = self._check_dt_value(dt)
         self.particles = _View(self._particles_numpy, lambda: self._n)
         self.contacts = _View(self._contacts_numpy, lambda: len(self._contacts_numpy()["pairs"]))
-        self.elements = _View(self._elements_numpy, lambda: 0)
+        self.elements = _View(self._elements_numpy,
+                              lambda: len(self._elements_numpy()["triangles"]))
 
     # ------------------------------------------------------------------ set-up
     def _law_id(self, law, argname="contact"):
@@ -302,10 +388,40 @@ class Simulation:
 
     def add_particles(self, positions, radius, density=2500.0, contact=None, material=None,
                       tolerance=0.0, velocity=None):
-        """Add discs; returns a :class:`ParticleGroup` (``.ids`` their indices)."""
+        """Add discs; returns a :class:`ParticleGroup` (``.ids`` their indices).
+
+        With ``material`` (tdem.Elastic, MohrCoulomb, Fluid) the particles are PCMM
+        particles of one continuum body: elements are created between particles of
+        the same material and tolerance δ (Eq. 1: d ≤ R_i + R_j + δ), their masses
+        follow Eq. 5 and ``density`` is the material's. ``contact`` then acts only
+        between particles that touch but share no element (and against walls and
+        other particles); by default a linear law with k_n = k_s = E (N/m per metre
+        of thickness) and friction tan φ (MohrCoulomb) or 0.5.
+        """
+        slot = -1
         if material is not None:
-            raise InputError("material: continuum (PCMM) particles are not available in this "
-                             f"version; got material={material!r}")
+            if not isinstance(material, Material):
+                raise InputError("material must be a continuum material such as "
+                                 f"tdem.Elastic(...), got {material!r}")
+            try:
+                tol = float(tolerance)
+            except (TypeError, ValueError):
+                raise InputError(f"tolerance must be a number >= 0, got {tolerance!r}") from None
+            if not (tol >= 0.0 and math.isfinite(tol)):
+                raise InputError(f"tolerance must be a number >= 0, got {tolerance!r}")
+            if self._built:
+                raise InputError("material: PCMM particles must be added before the first run "
+                                 "(their element system and masses are set up then)")
+            density = material.density
+            if contact is None:
+                young = getattr(material, "young", None) or 3.0 * material.bulk
+                fr = math.tan(math.radians(material.friction_angle)) \
+                    if isinstance(material, MohrCoulomb) else 0.5
+                contact = LinearContact(kn=young, ks=young, friction=fr)
+            slot = self._slot_of(material, tol)
+        elif self._built and self._cont is not None:
+            raise InputError("positions: particles cannot be added after the first run of a "
+                             "model with PCMM particles or blocks")
         pos = _as_xy("positions", positions)
         n = len(pos)
         if n == 0:
@@ -335,12 +451,57 @@ class Simulation:
         self._host["radius"].append(r)
         self._host["density"].append(rho)
         self._host["law"].append(np.full(n, law))
+        self._host["mat"].append(np.full(n, slot))
         self._n += n
         g = ParticleGroup(self, ids, contact, rho)
         self._groups.append(g)
         if state is not None:
             self._rebuild_from(state, new_particles=(pos, vel, r, rho, law))
         return g
+
+    def _slot_of(self, material, tol):
+        for k, (m, t) in enumerate(self._slots):
+            if m is material and t == tol:
+                return k
+        self._slots.append((material, tol))
+        return len(self._slots) - 1
+
+    def add_block(self, vertices, triangles, material, rigid=False, velocity=(0.0, 0.0)):
+        """Add a deformable block: a triangle mesh (vertices (V, 2), counter-clockwise
+        triangles (T, 3)) of a continuum material, with lumped nodal masses.
+        ``velocity``: initial velocity of every node. Returns a :class:`Block`."""
+        if rigid:
+            raise InputError("rigid: rigid blocks are not available in this version; "
+                             "got rigid=True (use a stiff deformable block)")
+        if not isinstance(material, Material):
+            raise InputError("material must be a continuum material such as "
+                             f"tdem.Elastic(...), got {material!r}")
+        if self._built:
+            raise InputError("vertices: blocks must be added before the first run")
+        x, t = _mesh.check_mesh(vertices, triangles)
+        used = np.zeros(len(x), bool)
+        used[t.ravel()] = True
+        if not used.all():
+            k = int(np.argmin(used))
+            raise InputError(f"vertices: vertex {k} belongs to no triangle")
+        v = _vector2("velocity", velocity)
+        slot = len(self._slots)
+        self._slots.append((material, None))
+        b = Block(self, len(self._blocks), x, t, material, slot,
+                  np.broadcast_to(v, x.shape).copy())
+        self._blocks.append(b)
+        return b
+
+    @property
+    def blocks(self):
+        return list(self._blocks)
+
+    def particles_in(self, xmin=-np.inf, xmax=np.inf, ymin=-np.inf, ymax=np.inf):
+        """Indices of the particles whose centres lie in the box (now)."""
+        if self._n == 0:
+            return np.zeros(0, np.int64)
+        pos = self._a["pos"].to_numpy() if self._built else np.concatenate(self._host["pos"])
+        return _in_box(pos, xmin, xmax, ymin, ymax)
 
     def set_contact(self, group_a, group_b, contact):
         """Use ``contact`` between particles of two groups (default: the law of the group
@@ -449,6 +610,8 @@ class Simulation:
         """Verlet skin (m): the given one, else 0.4 × the smallest radius."""
         if self._skin_user is not None:
             return self._skin_user
+        if self._n == 0:
+            return 0.0
         if self._skin_auto is None or self._skin_auto[0] != self._n:
             r = self._radii()
             self._skin_auto = (self._n, 0.4 * float(r.min()) if len(r) else 0.0)
@@ -460,14 +623,21 @@ class Simulation:
         return np.concatenate(self._host["radius"]) if self._host["radius"] else np.zeros(0)
 
     def critical_dt(self):
-        """Smallest 2·sqrt(m/k) over particles and the laws each one can meet (C&S p. 54)."""
+        """Smallest 2·sqrt(m/k) over particles and the laws each one can meet (C&S p. 54),
+        and, with continua, the shortest element altitude / c_p (PCMM elements in the
+        initial configuration, block triangles)."""
         key = (self._n, len(self._laws), len(self._walls_host), len(self._pair_override))
         if self._crit_cache is None or self._crit_cache[0] != key:
             self._crit_cache = (key, self._critical_dt())
         return self._crit_cache[1]
 
     def _critical_dt(self):
+        if self._slots:
+            self._require_built()
+        crit = self._cont.critical_dt() if self._cont is not None else np.inf
         if self._n == 0:
+            if self._blocks:
+                return crit
             raise InputError("the critical time step needs particles: add some first")
         r = self._radii()
         if self._built:
@@ -479,7 +649,6 @@ class Simulation:
             plaw = np.concatenate(self._host["law"])
         table = self._law_table()
         wall_laws = {int(w[stepk.W_LAW]) for w in self._walls_host}
-        crit = np.inf
         present = np.unique(plaw)
         for law_id in present:
             sel = plaw == law_id
@@ -538,6 +707,9 @@ class Simulation:
         r = np.concatenate(self._host["radius"])
         rho = np.concatenate(self._host["density"])
         m = rho * np.pi * r ** 2
+        if self._cont is not None and self._cont.has_pcmm:
+            pm = self._cont.masses
+            m = np.where(np.isnan(pm), m, pm)
         n = len(r)
         s = {
             "pos": pos, "vel": vel, "omega": np.zeros(n), "pos0": pos.copy(),
@@ -555,9 +727,27 @@ class Simulation:
         return s
 
     def _build(self):
-        if self._n == 0:
+        if self._n == 0 and not self._blocks:
             raise InputError("the simulation has no particles: call add_particles first")
+        if self._slots:
+            if self._n:
+                pos = np.concatenate(self._host["pos"])
+                rad = np.concatenate(self._host["radius"])
+                pmat = np.concatenate(self._host["mat"]).astype(np.int64)
+            else:
+                pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
+            self._cont = Continuum(pos, rad, pmat, self._slots, self._blocks)
+        if self._n == 0:
+            # blocks only: no particle arrays, the engine's parameters only
+            self._a = {"simp": ti.ndarray(ti.f64, (stepk.SIMP_SIZE,))}
+            self._built = True
+            self._upload_params()
+            return
         self._rebuild_from(self._fresh_state())
+
+    def _require_built(self):
+        if not self._built:
+            self._build()
 
     def _rebuild_from(self, state, new_particles=None):
         """(Re)allocate every array for the current sizes and fill it from ``state``."""
@@ -728,9 +918,30 @@ class Simulation:
                 a["nbr"], a["ncnt"], a["hist"],
                 a["cn"], a["cf"], a["cs"], a["rev"], a["rcnt"], a["wall"], a["wforce"],
                 a["wid"], a["whist"], a["wcn"], a["wcf"], a["wcs"], a["lawp"], a["lawpair"],
-                a["flags"], a["simp"], backend.serial_loops())
+                a["flags"], a["simp"], self._xforce(), a["cskip"], backend.serial_loops())
+
+    def _xforce(self):
+        if self._cont is not None:
+            return self._cont.a["xforce"]
+        x = self._a.get("xforce_none")
+        if x is None:
+            x = self._a["xforce_none"] = ti.Vector.ndarray(2, ti.f64, (1,))
+        return x
 
 
+
+    def _engine_args(self):
+        """Arguments of the step and rebuild kernels; the PCMM candidate search reach."""
+        if self._cont is not None and self._cont.has_pcmm:
+            h = float(self._a["gridp"].to_numpy()[2])
+            rmax = float(self._cont.a["rad"].to_numpy().max())
+            tmax = max((t for _, t in self._slots if t is not None), default=0.0)
+            self._reach = max(1, int(math.ceil((2 * rmax + tmax + 2 * self.skin) / h)))
+        else:
+            self._reach = 1
+        if self._n == 0:
+            return None, None
+        return self._step_args(), self._rebuild_args()
 
     def _rebuild_args(self):
         a = self._a
@@ -741,17 +952,30 @@ class Simulation:
                 len(self._walls_host), float(self.skin))
 
     def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
-        if self._fix_fn:
-            self._apply_fixes(t=self._time)
-        # on a GPU the rebuild kernel runs every step and returns at once unless the
-        # device raised the flag; on the CPU the host reads the flag (shared memory)
-        if not host_reads_flag or self._a["flags"][F_REBUILD] != 0:
-            neighbors.rebuild(*rebuild_args)
-        stepk.step(*step_args, detail)
+        """One step, the whole data flow (continua: see :mod:`tdem.continuum`)."""
+        cont = self._cont
+        if self._n:
+            if self._fix_fn:
+                self._apply_fixes(t=self._time)
+            # on a GPU the rebuild kernel runs every step and returns at once unless the
+            # device raised the flag; on the CPU the host reads the flag (shared memory)
+            if not host_reads_flag or self._a["flags"][F_REBUILD] != 0:
+                neighbors.rebuild(*rebuild_args)
+        if cont is not None:
+            cont.before_forces(self, self._dt_run, self._reach)
+        if self._n:
+            stepk.step(*step_args, detail, cont is not None and cont.has_pcmm)
+        if cont is not None:
+            cont.after_step(self)
         self._time += self._dt_run
         self._steps += 1
 
     def _take_snapshot(self):
+        if self._cont is not None:
+            self._cont.take_snapshot()
+        self._snap_clock = (self._time, self._steps)
+        if self._n == 0:
+            return
         for k in snapshot.ORDER:
             src = self._a[k]
             dst = self._snap.get(k)
@@ -767,8 +991,11 @@ class Simulation:
         return ti.ndarray(src.dtype, tuple(src.shape))
 
     def _restore_snapshot(self):
-        snapshot.copy_state(*[self._snap[k] for k in snapshot.ORDER],
-                            *[self._a[k] for k in snapshot.ORDER], backend.serial_loops())
+        if self._cont is not None:
+            self._cont.restore_snapshot()
+        if self._n:
+            snapshot.copy_state(*[self._snap[k] for k in snapshot.ORDER],
+                                *[self._a[k] for k in snapshot.ORDER], backend.serial_loops())
         self._time, self._steps = self._snap_clock
         for m in self._monitors:
             m.truncate(self._steps)
@@ -777,6 +1004,8 @@ class Simulation:
 
     def _status(self):
         a = self._a
+        if self._n == 0:
+            return np.array([0, 0, 0, 0, 0, 0, 0, 0], np.int32)
         stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["flags"],
                               float(self._dt_run))
         return a["flags"].to_numpy()
@@ -805,7 +1034,10 @@ class Simulation:
                              f"steps={steps!r}")
         if not self._built:
             self._build()
-        self._upload_laws()          # a law's parameters may have changed since (law.update)
+        if self._n:
+            self._upload_laws()      # a law's parameters may have changed since (law.update)
+        if self._cont is not None:
+            self._cont.upload_materials()
         self._crit_cache = None
         if self._dt_user is not None:
             self._check_dt_value(self._dt_user)  # particles or laws may have changed since
@@ -832,7 +1064,7 @@ class Simulation:
                     bar.update(self._steps - bar.n - done_at_start)
                     el = _time.perf_counter() - t_wall
                     bar.set_postfix_str(f"t={self._time:.4g}s, "
-                                        f"{self._n * (self._steps - done_at_start) / max(el, 1e-9):.3g} "
+                                        f"{self._dofs() * (self._steps - done_at_start) / max(el, 1e-9):.3g} "
                                         "particle-steps/s")
         except KeyboardInterrupt:
             self._restore_snapshot()
@@ -852,7 +1084,7 @@ class Simulation:
         """Up to ``check_interval`` steps from a snapshot, then one look at the device."""
         n = min(self.check_interval, target - self._steps)
         self._take_snapshot()
-        sargs, rargs = self._step_args(), self._rebuild_args()
+        sargs, rargs = self._engine_args()
         host_flag = self._host_reads_flag
         for s in range(n):
             # output-only quantities are stored on the steps something will read them
@@ -861,24 +1093,44 @@ class Simulation:
             if self._steps >= self._next_event:
                 self._events()
         flags = self._status()
-        if flags[F_NEED] > self._cap or flags[F_WALL_NEED] > self._capw:
+        if self._cont is not None:
+            need, bad = self._cont.status()
+            if need > self._cont.capacity:
+                self._restore_snapshot()
+                self._cont.grow(need)
+                return
+            if bad >= 0:
+                self._find_instability()
+        if self._n and (flags[F_NEED] > self._cap or flags[F_WALL_NEED] > self._capw):
             self._restore_snapshot()
             self._grow(flags)
             return
         if flags[F_BAD] < self._n:
             self._find_instability()
-        if self._steps - self._last_fit >= self.check_interval:
+        if self._n and self._steps - self._last_fit >= self.check_interval:
             self._fit_grid()
 
     def _find_instability(self):
         """Replay the last segment one step at a time to name the failing step."""
         self._restore_snapshot()
-        sargs, rargs = self._step_args(), self._rebuild_args()
+        sargs, rargs = self._engine_args()
         host_flag = self._host_reads_flag
         for _ in range(self.check_interval + 1):
             self._take_snapshot()
             self._one_step(sargs, rargs, host_flag, True)
             flags = self._status()
+            if self._cont is not None and self._cont.status()[1] >= 0:
+                v = self._cont.status()[1]
+                step, t = self._steps, self._time
+                nodes = self._cont.a["npos"].to_numpy()[v], self._cont.a["nvel"].to_numpy()[v]
+                self._restore_snapshot()
+                b = next(b for b in self._blocks if b._offset <= v < b._offset + len(b))
+                raise InstabilityError(
+                    f"unstable at step {step} (t = {t:.6g} s): node {v - b._offset} of block "
+                    f"{b.index} has position {nodes[0].tolist()} and velocity "
+                    f"{nodes[1].tolist()} (dt = {self._dt_run:.3g} s). The last good state "
+                    f"(step {self._steps}) is kept; reduce dt_fraction.",
+                    step=step, time=t, particle=-1)
             if flags[F_BAD] < self._n:
                 k = int(flags[F_BAD])
                 step, t = self._steps, self._time
@@ -912,10 +1164,14 @@ class Simulation:
         if self._output is not None:
             self._output.abort(self, why)
 
+    def _dofs(self):
+        """Particles plus block nodes (the bodies the throughput counts)."""
+        return self._n + (self._cont.nv if self._cont is not None else 0)
+
     def _progress_bar(self, total):
         show = self.progress
         if show is None:
-            show = sys.stderr.isatty() and self._n * total > 2e7
+            show = sys.stderr.isatty() and self._dofs() * total > 2e7
         if not show or total <= 0:
             return None
         from tqdm.auto import tqdm
@@ -946,10 +1202,29 @@ class Simulation:
             st = np.zeros((self._n, 2, 2))
             st[:, 0, 0], st[:, 1, 1] = s[:, 0], s[:, 1]
             st[:, 0, 1] = st[:, 1, 0] = s[:, 2]
-            out["stress"] = st
-            out["stress_zz"] = np.zeros(self._n)
-            out["pressure"] = -(s[:, 0] + s[:, 1]) / 3.0
+            szz = np.zeros(self._n)
             out["plastic_strain"] = np.zeros(self._n)
+            out["strain"] = np.zeros((self._n, 3))
+            if self._cont is not None and self._cont.has_pcmm:
+                c = self._cont.particle_fields()
+                sel = c["pmat"] >= 0
+                s4 = c["stress4"]
+                st[sel, 0, 0], st[sel, 1, 1] = s4[sel, 0], s4[sel, 1]
+                st[sel, 0, 1] = st[sel, 1, 0] = s4[sel, 2]
+                szz[sel] = s4[sel, 3]
+                out["plastic_strain"] = c["plastic_strain"]
+                out["strain"] = c["strain"]
+                out["failed"] = c["failed"]
+                out["elements"] = c["elements"]
+            out["stress"] = st
+            out["stress_zz"] = szz
+            out["pressure"] = -(st[:, 0, 0] + st[:, 1, 1] + szz) / 3.0
+            # a disc's own stress has no out-of-plane part: its pressure is the in-plane mean
+            if self._cont is None or not self._cont.has_pcmm:
+                out["pressure"] = -(st[:, 0, 0] + st[:, 1, 1]) / 2.0
+            else:
+                dem = ~sel
+                out["pressure"][dem] = -(st[dem, 0, 0] + st[dem, 1, 1]) / 2.0
         return out
 
     def _contacts_numpy(self):
@@ -989,9 +1264,16 @@ class Simulation:
         }
 
     def _elements_numpy(self):
-        """Continuum elements (PCMM): none in a model of plain DEM discs."""
-        return {"triangles": np.zeros((0, 3), np.int64), "weight": np.zeros(0),
-                "stress": np.zeros((0, 2, 2))}
+        """PCMM elements now (copies included): triangles (E, 3) of particle indices,
+        owner, area, n_cover (N_e), weight (1/N_e), stress (E, 2, 2), stress_zz."""
+        if not self._built:
+            self._build()
+        if self._cont is None or not self._cont.has_pcmm:
+            return {"triangles": np.zeros((0, 3), np.int64), "owner": np.zeros(0, np.int64),
+                    "area": np.zeros(0), "n_cover": np.zeros(0, np.int64),
+                    "weight": np.zeros(0), "stress": np.zeros((0, 2, 2)),
+                    "stress_zz": np.zeros(0)}
+        return self._cont.elements()
 
     def energy(self):
         """Energy account (J per metre of thickness) at the last completed step:

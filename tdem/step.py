@@ -196,11 +196,17 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          wid: ti.types.ndarray(), whist: ti.types.ndarray(), wcn: ti.types.ndarray(),
          wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
-         simp: ti.types.ndarray(), serial: ti.template(), detail: ti.template()):
+         simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
+         serial: ti.template(), detail: ti.template(), continuum: ti.template()):
     """One step. ``detail`` (a compile-time switch) also stores what only output
     reads: per-contact normals, scalar forces and overlaps, particle forces, and
     the kinetic and gravitational energy at t_n. The host asks for it on the last
-    step before anything looks at the state."""
+    step before anything looks at the state.
+
+    ``continuum`` (compile-time): PCMM particles are present. Their element forces
+    of this step (``xforce``, from :func:`physics.pcmm.update`) join the contact
+    forces, and pair slots marked in ``cskip`` (particles that share an element)
+    have no DEM contact."""
     n = pos.shape[0]
     cap = nbr.shape[1]
     bits = slot_bits(cap)
@@ -229,9 +235,21 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         pi = prop[i]
         li = plaw[i]
         for k in range(ncnt[i]):
-            fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel, omega,
-                                           prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt,
-                                           detail)
+            fk = ti.Vector([0.0, 0.0])
+            mk = 0.0
+            mjk = 0.0
+            dk = 0.0
+            skip = 0
+            if ti.static(continuum):
+                skip = cskip[i, k]
+            if skip != 0:
+                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                if ti.static(detail):
+                    cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
+            else:
+                fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel,
+                                               omega, prop, plaw, lawp, lawpair, nbr, hist, cn,
+                                               cs, dt, detail)
             f += fk
             tq += mk
             diss += dk
@@ -266,6 +284,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 c = cf[j, k]
                 f -= ti.Vector([c[0], c[1]])
                 tq += c[2]
+        if ti.static(continuum):
+            f += xforce[i]
         m = prop[i][1]
         inertia = prop[i][2]
         v0 = vel[i]

@@ -1,0 +1,85 @@
+"""Deformable blocks: triangle meshes with fixed connectivity (spec §4).
+
+A block is the element model the paper compares every PCMM model against: the
+same incremental FVM update as the PCMM elements (:mod:`physics.fvm`, Eqs. 6–14)
+with no superposition (weight 1), the stress living on the element, and lumped
+nodal masses ρ·S/3. Elastic, Mohr–Coulomb and Fluid materials
+(:mod:`physics.materials`) apply; brittle softening acts per element.
+
+Arrays (all blocks of a simulation concatenated; node indices are global):
+
+- ``tri`` (T,) 3 × i32, counter-clockwise; ``tmat`` (T,) i32 material row;
+- ``tsig`` (T,) 4 × f64 stress (σxx, σyy, σxy, σzz), tension-positive;
+- ``tstate`` (T,) 4 × f64: plastic shear strain, failed (0/1), −, −;
+- ``tfor`` (T,) 6 × f64: the element's forces on its three nodes of this step;
+- ``inc_start`` (V + 1,) / ``inc`` (3T,) i32: for node v, the entries
+  ``inc[inc_start[v]:inc_start[v + 1]]`` = 3·t + corner of the triangles it belongs
+  to, so that nodal forces are gathered without atomics in a fixed order.
+"""
+import numpy as np
+import taichi as ti
+
+from . import fvm
+from .materials import mc_correct_state
+from .pcmm import viscous_stress
+
+
+@ti.kernel
+def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.ndarray(),
+           tmat: ti.types.ndarray(), matp: ti.types.ndarray(), tsig: ti.types.ndarray(),
+           tstate: ti.types.ndarray(), tfor: ti.types.ndarray(),
+           inc_start: ti.types.ndarray(), inc: ti.types.ndarray(),
+           nforce: ti.types.ndarray(), dt: ti.f64, serial: ti.template()):
+    """One step of every block triangle (stress and nodal forces), then the element
+    forces gathered into ``nforce`` (overwritten)."""
+    ti.loop_config(serialize=serial)
+    for e in range(tri.shape[0]):
+        t = tri[e]
+        xa, xb, xc = npos[t[0]], npos[t[1]], npos[t[2]]
+        grad = fvm.velocity_gradient(xa, xb, xc, nvel[t[0]], nvel[t[1]], nvel[t[2]])
+        de = fvm.strain_increment(grad, dt)
+        M = tmat[e]
+        sig = fvm.jaumann_rotate(tsig[e], fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+            de, matp[M, 2], matp[M, 3])
+        st = tstate[e]
+        sig, eps, flag = mc_correct_state(sig, matp, M, ti.cast(st[1] > 0.0, ti.i32))
+        tsig[e] = sig
+        st[0] += eps
+        if flag > 0:
+            st[1] = 1.0
+        tstate[e] = st
+        fa, fb, fc = fvm.nodal_forces(sig + viscous_stress(matp, M, de, dt), xa, xb, xc, 1.0)
+        tfor[e] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+    ti.loop_config(serialize=serial)
+    for v in range(nforce.shape[0]):
+        f = ti.Vector([0.0, 0.0])
+        for q in range(inc_start[v], inc_start[v + 1]):
+            code = inc[q]
+            e = code // 3
+            c = code - 3 * e
+            fe = tfor[e]
+            f += ti.Vector([fe[2 * c], fe[2 * c + 1]])
+        nforce[v] = f
+
+
+def incidence(triangles, n_nodes):
+    """(inc_start, inc) of the module docstring for triangles (T, 3)."""
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    node = t.ravel()
+    code = np.arange(node.size)          # 3·t + corner
+    order = np.argsort(node, kind="stable")
+    counts = np.bincount(node, minlength=n_nodes)
+    start = np.zeros(n_nodes + 1, np.int64)
+    start[1:] = np.cumsum(counts)
+    return start.astype(np.int32), code[order].astype(np.int32)
+
+
+def altitudes(vertices, triangles):
+    """Smallest altitude 2S/longest edge of each triangle (the time-step length)."""
+    x = np.asarray(vertices, dtype=float)
+    t = np.asarray(triangles, dtype=np.int64)
+    p = x[t]
+    e = np.roll(p, -1, axis=1) - p
+    length = np.linalg.norm(e, axis=2)
+    area = 0.5 * np.abs(e[:, 0, 0] * e[:, 1, 1] - e[:, 0, 1] * e[:, 1, 0])
+    return 2.0 * area / length.max(axis=1)

@@ -1,0 +1,381 @@
+"""The continuum parts of a simulation: PCMM bodies and deformable blocks.
+
+One step of a model with continua (:meth:`tdem.Simulation._one_step`):
+
+    neighbour lists (engine, when the skin asks)
+      -> PCMM candidates (only after a list build)            physics.pcmm.candidates
+      -> PCMM elements, stresses, nodal forces, gathered     physics.pcmm.update
+      -> block element stresses and nodal forces            physics.blocks.update
+      -> DEM contacts + element forces, leapfrog           tdem.step.step
+      -> block nodes: damping, prescribed velocities, leapfrog   integrate_nodes
+
+PCMM particles are particles of the engine (they move, collide and are output
+with the others); what is added here is their element system and stress state.
+Block nodes are not particles: they have their own arrays and integrator, and
+blocks are output as meshes.
+"""
+import math
+
+import numpy as np
+import taichi as ti
+
+from physics import blocks as blk
+from physics import pcmm
+from physics.materials import MAT_WIDTH
+
+from . import backend
+from .errors import CapacityError
+from .mesh import nodal_masses
+from .neighbors import F_BUILDS
+from .step import FIX_VX, FIX_VY, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY
+
+MAX_CANDIDATES = 1024
+
+# arrays copied into the run segment's snapshot (the dynamic state)
+_SNAP = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags",
+         "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags")
+
+
+@ti.kernel
+def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
+                    nmass: ti.types.ndarray(), nforce: ti.types.ndarray(),
+                    nfix: ti.types.ndarray(), nvfix: ti.types.ndarray(),
+                    nsize: ti.types.ndarray(), nreact: ti.types.ndarray(),
+                    simp: ti.types.ndarray(), nflags: ti.types.ndarray(),
+                    serial: ti.template()):
+    """Block nodes, as the particles in :func:`tdem.step.step`: gravity, local and
+    global damping, prescribed velocity components (``nreact`` = the force the
+    constraint applies), leapfrog. nflags[0] = smallest index of a node with a
+    non-finite state or moving more than half its size in one step."""
+    dt = simp[P_DT]
+    g = ti.Vector([simp[P_GX], simp[P_GY]])
+    alpha = simp[P_ALPHA]
+    alpha_l = simp[P_ALPHA_LOCAL]
+    nv = npos.shape[0]
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        nflags[0] = nv
+    ti.loop_config(serialize=serial)
+    for v in range(nv):
+        m = nmass[v]
+        v0 = nvel[v]
+        f = nforce[v] + m * g
+        fd = -alpha_l * ti.abs(f) * ti.math.sign(v0)
+        den = 1.0 + 0.5 * alpha * dt
+        v1 = (v0 * (1.0 - 0.5 * alpha * dt) + (f + fd) / m * dt) / den
+        vfree = v1
+        fx = nfix[v]
+        if fx & 1:
+            v1[0] = nvfix[v][0]
+        if fx & 2:
+            v1[1] = nvfix[v][1]
+        nreact[v] = m * (v1 - vfree) / dt
+        x1 = npos[v] + v1 * dt
+        nvel[v] = v1
+        npos[v] = x1
+        s = x1[0] + x1[1] + v1[0] + v1[1]
+        bad = not (s == s) or ti.abs(s) > 1e300
+        if not bad:
+            bad = v1.norm() * dt > 0.5 * nsize[v]
+        if bad:
+            ti.atomic_min(nflags[0], v)
+
+
+def _arr(spec, shape, dtype=ti.f64):
+    if spec == 0:
+        return ti.ndarray(dtype, shape)
+    return ti.Vector.ndarray(spec, dtype, shape)
+
+
+class Continuum:
+    """Arrays and kernels of the PCMM bodies and blocks of one simulation.
+
+    Parameters
+    ----------
+    pos, rad : (N, 2), (N,) the particles (all of them)
+    pmat : (N,) material slot of each particle, −1 for a plain DEM disc
+    slots : list of (material, tolerance) per slot (blocks' slots have tolerance None)
+    blocks : list of :class:`tdem.simulation.Block`
+    """
+
+    def __init__(self, pos, rad, pmat, slots, blocks, capacity=16):
+        self.n = len(rad)
+        self.slots = slots
+        self.blocks = blocks
+        self.has_pcmm = bool((pmat >= 0).any())
+        self.capacity = capacity
+        self.masses = None
+        self._crit = math.inf
+        self._initial_elements(pos, rad, pmat)
+        a = self.a = {}
+        n, cap, E = self.n, self.capacity, pcmm.MAX_ELEMENTS
+        nm = max(len(slots), 1)
+        a["rad"] = ti.ndarray(ti.f64, (n,))
+        a["rad"].from_numpy(np.asarray(rad, dtype=np.float64))
+        a["pmat"] = ti.ndarray(ti.i32, (n,))
+        a["pmat"].from_numpy(pmat.astype(np.int32))
+        a["matp"] = ti.ndarray(ti.f64, (nm, MAT_WIDTH))
+        a["mtol"] = ti.ndarray(ti.f64, (nm,))
+        self.upload_materials()
+        a["ccnt"] = ti.ndarray(ti.i32, (n,))
+        a["ncnt"] = ti.ndarray(ti.i32, (n,))
+        a["elem"] = ti.ndarray(ti.i32, (n, E, 2))
+        a["ecnt"] = ti.ndarray(ti.i32, (n,))
+        a["earea"] = ti.ndarray(ti.f64, (n, E))
+        a["ncov"] = ti.ndarray(ti.i32, (n, E))
+        a["esig"] = _arr(4, (n, E))
+        a["efor"] = _arr(6, (n, E))
+        a["ede"] = _arr(5, (n, E))
+        a["psig"] = _arr(4, (n,))
+        a["peps"] = _arr(3, (n,))
+        a["pstate"] = _arr(4, (n,))
+        a["xforce"] = _arr(2, (n,))
+        a["pflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
+        a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
+        self._alloc_lists()
+        self._setup_blocks()
+        self.snap = {}
+
+    # ------------------------------------------------------------------ set-up
+    def _initial_elements(self, pos, rad, pmat):
+        """Eq. 5 masses and the shortest element altitude of each PCMM body, from
+        its element system in the initial configuration."""
+        self.masses = np.full(self.n, np.nan)
+        for s, (mat, tol) in enumerate(self.slots):
+            if tol is None:
+                continue
+            ids = np.flatnonzero(pmat == s)
+            if len(ids) == 0:
+                continue
+            es = pcmm.ElementSystem(pos[ids], rad[ids], tol).build()
+            self.masses[ids] = es.masses(mat.density)
+            self.capacity = max(self.capacity, 1 << int(es.neighbour_need).bit_length())
+            tri = es.numpy()["triangles"]
+            if len(tri):
+                alt = blk.altitudes(pos[ids], tri)
+                self._crit = min(self._crit, float(alt.min()) / mat.p_wave_speed)
+
+    def _alloc_lists(self):
+        n, cap = self.n, self.capacity
+        a = self.a
+        old = a.get("cand")
+        a["cand"] = ti.ndarray(ti.i32, (n, cap))
+        a["nbr"] = ti.ndarray(ti.i32, (n, cap))
+        a["ring"] = ti.ndarray(ti.i32, (n, cap))
+        a["rang"] = ti.ndarray(ti.f64, (n, cap))
+        if old is not None:
+            # forces a candidate build at the next step
+            a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
+
+    def _setup_blocks(self):
+        a = self.a
+        verts, tris, tmat, mass, size = [], [], [], [], []
+        off = 0
+        for b in self.blocks:
+            b._offset = off
+            verts.append(b.vertices)
+            tris.append(b.triangles + off)
+            tmat.append(np.full(len(b.triangles), b.slot, np.int32))
+            mass.append(nodal_masses(b.vertices, b.triangles, b.material.density))
+            alt = blk.altitudes(b.vertices, b.triangles)
+            ns = np.full(len(b.vertices), np.inf)
+            for k in range(3):
+                np.minimum.at(ns, b.triangles[:, k], alt)
+            size.append(ns)
+            self._crit = min(self._crit, float(alt.min()) / b.material.p_wave_speed)
+            off += len(b.vertices)
+        self.nv = off
+        nv, nt = max(off, 1), max(sum(len(t) for t in tris), 1)
+        self.nt = sum(len(t) for t in tris)
+        for k, spec in (("npos", 2), ("npos0", 2), ("nvel", 2), ("nforce", 2), ("nreact", 2),
+                        ("nvfix", 2), ("nmass", 0), ("nsize", 0)):
+            a[k] = _arr(spec, (nv,))
+        a["nfix"] = ti.ndarray(ti.i32, (nv,))
+        a["tri"] = ti.Vector.ndarray(3, ti.i32, (nt,))
+        a["tmat"] = ti.ndarray(ti.i32, (nt,))
+        a["tsig"] = _arr(4, (nt,))
+        a["tstate"] = _arr(4, (nt,))
+        a["tfor"] = _arr(6, (nt,))
+        a["nflags"] = ti.ndarray(ti.i32, (2,))
+        if off == 0:
+            a["inc_start"] = ti.ndarray(ti.i32, (2,))
+            a["inc"] = ti.ndarray(ti.i32, (1,))
+            return
+        x = np.concatenate(verts)
+        t = np.concatenate(tris)
+        a["npos"].from_numpy(x)
+        a["npos0"].from_numpy(x)
+        a["nvel"].from_numpy(np.concatenate([b.velocity for b in self.blocks]))
+        a["nmass"].from_numpy(np.concatenate(mass))
+        a["nsize"].from_numpy(np.concatenate(size))
+        a["tri"].from_numpy(t.astype(np.int32))
+        a["tmat"].from_numpy(np.concatenate(tmat))
+        start, inc = blk.incidence(t, off)
+        a["inc_start"] = ti.ndarray(ti.i32, (len(start),))
+        a["inc_start"].from_numpy(start)
+        a["inc"] = ti.ndarray(ti.i32, (len(inc),))
+        a["inc"].from_numpy(inc)
+        self.apply_node_fixes(0.0, initial=True)
+
+    def upload_materials(self):
+        rows = np.zeros((max(len(self.slots), 1), MAT_WIDTH))
+        tol = np.zeros(max(len(self.slots), 1))
+        for s, (mat, t) in enumerate(self.slots):
+            rows[s] = mat.row()
+            tol[s] = 0.0 if t is None else t
+        self.a["matp"].from_numpy(rows)
+        self.a["mtol"].from_numpy(tol)
+
+    def apply_node_fixes(self, t, initial=False):
+        """Upload prescribed node velocities (all, or the functions of time at t)."""
+        if self.nv == 0:
+            return False
+        if initial:
+            self._nfix = np.zeros(self.nv, np.int32)
+            self._nvfix = np.zeros((self.nv, 2))
+        any_fn = False
+        for b in self.blocks:
+            for ids, vx, vy in b._fixes:
+                g = ids + b._offset
+                for bit, col, v in ((FIX_VX, 0, vx), (FIX_VY, 1, vy)):
+                    if v is None:
+                        continue
+                    if initial:
+                        self._nfix[g] |= bit
+                    if callable(v):
+                        any_fn = True
+                        self._nvfix[g, col] = np.broadcast_to(np.asarray(v(t), float), g.shape)
+                    elif initial:
+                        self._nvfix[g, col] = v
+        if initial:
+            self.a["nfix"].from_numpy(self._nfix)
+            self._fix_fn = any_fn
+        self.a["nvfix"].from_numpy(self._nvfix)
+        return any_fn
+
+    # ------------------------------------------------------------------ stepping
+    def critical_dt(self):
+        """Shortest element altitude / c_p over the initial PCMM elements and the
+        block triangles (the Courant step of the element model)."""
+        return self._crit
+
+    def before_forces(self, sim, dt, reach):
+        """Candidates (after a list build), PCMM update and block update of one step."""
+        a, e = self.a, sim._a
+        serial = backend.serial_loops()
+        if self._fix_fn_nodes():
+            self.apply_node_fixes(sim._time)
+        if self.has_pcmm:
+            pcmm.candidates(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
+                            e["cell_count"], e["cell_start"], e["sorted"], e["gridp"],
+                            e["gridn"], e["flags"], a["pflags"], F_BUILDS,
+                            float(sim.skin), int(reach))
+            pcmm.update(e["pos"], e["vel"], a["rad"], a["pmat"], a["matp"], a["mtol"],
+                        a["cand"], a["ccnt"], a["nbr"], a["ncnt"], a["ring"], a["rang"],
+                        a["elem"], a["ecnt"], a["earea"], a["ncov"], a["esig"], a["efor"],
+                        a["ede"], a["psig"], a["peps"], a["pstate"], a["xforce"], e["nbr"],
+                        e["ncnt"], e["cskip"], float(dt), serial)
+        if self.nv:
+            blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
+                       a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
+                       float(dt), serial)
+
+    def _fix_fn_nodes(self):
+        return self.nv and getattr(self, "_fix_fn", False)
+
+    def after_step(self, sim):
+        if self.nv:
+            a = self.a
+            integrate_nodes(a["npos"], a["nvel"], a["nmass"], a["nforce"], a["nfix"],
+                            a["nvfix"], a["nsize"], a["nreact"], sim._a["simp"], a["nflags"],
+                            backend.serial_loops())
+
+    def status(self):
+        """(candidate slots needed, first unstable node or −1)."""
+        need = int(self.a["pflags"].to_numpy()[pcmm.P_NEED]) if self.has_pcmm else 0
+        bad = -1
+        if self.nv:
+            b = int(self.a["nflags"].to_numpy()[0])
+            bad = b if b < self.nv else -1
+        return need, bad
+
+    def grow(self, need):
+        new = 1 << int(need).bit_length()
+        if new > MAX_CANDIDATES:
+            raise CapacityError(f"a PCMM particle has {need} Eq. 1 candidates, more than "
+                                f"{MAX_CANDIDATES}: is the tolerance far larger than the radii?")
+        self.capacity = new
+        self._alloc_lists()
+        self.snap.pop("cand", None)
+
+    def take_snapshot(self):
+        for k in _SNAP:
+            src = self.a[k]
+            dst = self.snap.get(k)
+            if dst is None or tuple(dst.shape) != tuple(src.shape):
+                dst = self.snap[k] = (ti.Vector.ndarray(src.n, src.dtype, tuple(src.shape))
+                                      if hasattr(src, "n") else
+                                      ti.ndarray(src.dtype, tuple(src.shape)))
+            dst.copy_from(src)
+
+    def restore_snapshot(self):
+        for k in _SNAP:
+            dst = self.a[k]
+            src = self.snap.get(k)
+            if src is not None and tuple(src.shape) == tuple(dst.shape):
+                dst.copy_from(src)
+        if self.snap.get("cand") is None:
+            self.a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
+
+    # ------------------------------------------------------------------ reading
+    def elements(self):
+        """PCMM elements now (copies included): triangles (E, 3), owner, area, n_cover,
+        weight (1/N_e), stress (E, 2, 2), stress_zz (E,)."""
+        a = self.a
+        ecnt = a["ecnt"].to_numpy()
+        owner = np.repeat(np.arange(self.n), ecnt)
+        slot = np.arange(len(owner)) - np.repeat(np.cumsum(ecnt) - ecnt, ecnt)
+        elem = a["elem"].to_numpy()[owner, slot]
+        ncov = a["ncov"].to_numpy()[owner, slot]
+        sig = a["esig"].to_numpy()[owner, slot]
+        return {"triangles": np.column_stack([owner, elem]).astype(np.int64),
+                "owner": owner.astype(np.int64),
+                "area": a["earea"].to_numpy()[owner, slot],
+                "n_cover": ncov.astype(np.int64),
+                "weight": 1.0 / np.maximum(ncov, 1),
+                "stress": _tensor(sig), "stress_zz": sig[:, 3].copy()}
+
+    def particle_fields(self):
+        """Continuum state per particle: stress (N, 4), strain (N, 3), plastic shear
+        strain, failed, element count."""
+        a = self.a
+        st = a["pstate"].to_numpy()
+        return {"stress4": a["psig"].to_numpy(), "strain": a["peps"].to_numpy(),
+                "plastic_strain": st[:, 0].copy(), "failed": st[:, 1] > 0.5,
+                "elements": st[:, 2].astype(np.int64), "pmat": a["pmat"].to_numpy()}
+
+    def block_nodes(self, b):
+        a = self.a
+        sl = slice(b._offset, b._offset + len(b.vertices))
+        pos = a["npos"].to_numpy()[sl]
+        return {"position": pos, "velocity": a["nvel"].to_numpy()[sl],
+                "force": a["nforce"].to_numpy()[sl], "reaction": a["nreact"].to_numpy()[sl],
+                "mass": a["nmass"].to_numpy()[sl],
+                "displacement": pos - a["npos0"].to_numpy()[sl]}
+
+    def block_elements(self, b):
+        a = self.a
+        first = sum(len(o.triangles) for o in self.blocks[:self.blocks.index(b)])
+        sl = slice(first, first + len(b.triangles))
+        sig = a["tsig"].to_numpy()[sl]
+        st = a["tstate"].to_numpy()[sl]
+        return {"triangles": b.triangles.copy(), "stress": _tensor(sig),
+                "stress_zz": sig[:, 3].copy(), "plastic_strain": st[:, 0].copy(),
+                "failed": st[:, 1] > 0.5}
+
+
+def _tensor(s4):
+    out = np.zeros((len(s4), 2, 2))
+    out[:, 0, 0], out[:, 1, 1] = s4[:, 0], s4[:, 1]
+    out[:, 0, 1] = out[:, 1, 0] = s4[:, 2]
+    return out
