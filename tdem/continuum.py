@@ -108,12 +108,13 @@ class Continuum:
         self._crit = math.inf
         self._initial_elements(pos, rad, pmat)
         a = self.a = {}
-        n, cap, E = self.n, self.capacity, pcmm.MAX_ELEMENTS
+        n, cap, E = max(self.n, 1), self.capacity, pcmm.MAX_ELEMENTS
         nm = max(len(slots), 1)
         a["rad"] = ti.ndarray(ti.f64, (n,))
-        a["rad"].from_numpy(np.asarray(rad, dtype=np.float64))
         a["pmat"] = ti.ndarray(ti.i32, (n,))
-        a["pmat"].from_numpy(pmat.astype(np.int32))
+        if self.n:
+            a["rad"].from_numpy(np.asarray(rad, dtype=np.float64))
+            a["pmat"].from_numpy(pmat.astype(np.int32))
         a["matp"] = ti.ndarray(ti.f64, (nm, MAT_WIDTH))
         a["mtol"] = ti.ndarray(ti.f64, (nm,))
         self.upload_materials()
@@ -156,7 +157,7 @@ class Continuum:
                 self._crit = min(self._crit, float(alt.min()) / mat.p_wave_speed)
 
     def _alloc_lists(self):
-        n, cap = self.n, self.capacity
+        n, cap = max(self.n, 1), self.capacity
         a = self.a
         old = a.get("cand")
         a["cand"] = ti.ndarray(ti.i32, (n, cap))

@@ -101,8 +101,74 @@ def write_particles_vtu(sim, path, particles=None):
         "stress": st.reshape(n, 9),
         "pressure": np.asarray(p["pressure"], dtype=np.float64),
     }
+    for name in ("plastic_strain", "elements"):
+        if name in p:
+            point_data[name] = np.asarray(p[name], dtype=np.float64)
+    if "failed" in p:
+        point_data["failed"] = np.asarray(p["failed"], dtype=np.int64)
+    if "strain" in p:
+        e = np.asarray(p["strain"], dtype=np.float64)
+        point_data["strain"] = np.stack([e[:, 0], e[:, 2], np.zeros(n), e[:, 2], e[:, 1],
+                                         np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)], 1)
     _write_mesh(path, _xyz(p["position"]), [("vertex", np.arange(n, dtype=np.int64)[:, None])],
                 point_data=point_data)
+    return path
+
+
+def _stress9(s, szz):
+    out = np.zeros((len(s), 3, 3))
+    out[:, :2, :2] = s
+    out[:, 2, 2] = szz
+    return out.reshape(len(s), 9)
+
+
+def write_elements_vtu(sim, path, particles=None):
+    """PCMM elements of ``sim`` to ``path``: one ``triangle`` cell per element (copies
+    included) on the particle centres. Cell data: ``stress`` (Pa, 3×3 row-major,
+    tension-positive), ``weight`` (1/N_e), ``n_cover`` (N_e), ``owner``; point data
+    as the particles' ``displacement``, ``velocity`` and ``pressure``."""
+    e = sim.elements.numpy()
+    p = sim.particles.numpy() if particles is None else particles
+    tri = np.asarray(e["triangles"], dtype=np.int64).reshape(-1, 3)
+    cell_data = {"stress": [_stress9(e["stress"], e["stress_zz"])],
+                 "weight": [np.asarray(e["weight"], dtype=np.float64)],
+                 "n_cover": [np.asarray(e["n_cover"], dtype=np.int64)],
+                 "owner": [np.asarray(e["owner"], dtype=np.int64)]}
+    point_data = {"displacement": _xyz(p["displacement"]), "velocity": _xyz(p["velocity"]),
+                  "pressure": np.asarray(p["pressure"], dtype=np.float64)}
+    _write_mesh(path, _xyz(p["position"]), [("triangle", tri)], point_data=point_data,
+                cell_data=cell_data)
+    return path
+
+
+def write_blocks_vtu(sim, path):
+    """Blocks of ``sim`` to ``path``: their triangles on the current node positions.
+    Point data: ``block``, ``velocity``, ``displacement``, ``force``, ``reaction``;
+    cell data: ``block``, ``stress`` (Pa, 3×3 row-major), ``pressure``,
+    ``plastic_strain``, ``failed``."""
+    pts, tris, pd, cd = [], [], {k: [] for k in ("block", "velocity", "displacement",
+                                                  "force", "reaction")}, \
+        {k: [] for k in ("block", "stress", "pressure", "plastic_strain", "failed")}
+    off = 0
+    for b in sim.blocks:
+        nd = b.nodes()
+        el = b.elements()
+        pts.append(_xyz(nd["position"]))
+        tris.append(el["triangles"] + off)
+        off += len(nd["position"])
+        pd["block"].append(np.full(len(nd["position"]), b.index, np.int64))
+        for k in ("velocity", "displacement", "force", "reaction"):
+            pd[k].append(_xyz(nd[k]))
+        t = len(el["triangles"])
+        cd["block"].append(np.full(t, b.index, np.int64))
+        cd["stress"].append(_stress9(el["stress"], el["stress_zz"]))
+        cd["pressure"].append(-(el["stress"][:, 0, 0] + el["stress"][:, 1, 1]
+                                + el["stress_zz"]) / 3.0)
+        cd["plastic_strain"].append(el["plastic_strain"])
+        cd["failed"].append(el["failed"].astype(np.int64))
+    _write_mesh(path, np.concatenate(pts), [("triangle", np.concatenate(tris))],
+                point_data={k: np.concatenate(v) for k, v in pd.items()},
+                cell_data={k: [np.concatenate(v)] for k, v in cd.items()})
     return path
 
 
@@ -178,12 +244,25 @@ def write_vtu(sim, path, walls=True, contacts=True):
     path.parent.mkdir(parents=True, exist_ok=True)
     p = sim.particles.numpy()
     written = [str(write_particles_vtu(sim, path, p))]
+    if _has_elements(sim):
+        written.append(str(write_elements_vtu(sim, path.with_name(path.stem + "_elements.vtu"),
+                                              p)))
+    if sim.blocks:
+        written.append(str(write_blocks_vtu(sim, path.with_name(path.stem + "_blocks.vtu"))))
     if walls:
         written.append(str(write_walls_vtu(sim, path.with_name(path.stem + "_walls.vtu"))))
     if contacts:
         written.append(str(write_contacts_vtu(sim, path.with_name(path.stem + "_contacts.vtu"),
                                               p)))
     return written
+
+
+def _has_elements(sim):
+    return any(t is not None for _, t in getattr(sim, "_slots", []))
+
+
+def _has_bodies(sim):
+    return getattr(sim, "n_particles", 0) > 0 or bool(getattr(sim, "blocks", []))
 
 
 def write_pvd(path, entries):
@@ -304,12 +383,16 @@ class Output:
         self._entries = []          # (step, time, snapshot number), in step order
         self._start = (0, 0.0) if sim is None else (int(sim.steps), float(sim.time))
         self._initial_due = sim is not None
-        if sim is not None and getattr(sim, "n_particles", 0) > 0:
+        if sim is not None and _has_bodies(sim):
             self._write_initial(sim)
 
     # ---------------------------------------------------------------- paths
     def _names(self, k):
         names = {"particles": f"particles_{k:05d}.vtu"}
+        if self._sim is not None and _has_elements(self._sim):
+            names["elements"] = f"elements_{k:05d}.vtu"
+        if self._sim is not None and self._sim.blocks:
+            names["blocks"] = f"blocks_{k:05d}.vtu"
         if self.walls:
             names["walls"] = f"walls_{k:05d}.vtu"
         if self.contacts:
@@ -336,7 +419,7 @@ class Output:
         """The step at which the next snapshot is due (a very large number when none
         is). If output was set up before the simulation had particles, the initial
         snapshot is written here, at the start of the first run."""
-        if self._initial_due and getattr(sim, "_built", True) and sim.n_particles > 0:
+        if self._initial_due and getattr(sim, "_built", True) and _has_bodies(sim):
             self._write_initial(sim)
         if self.every is not None:
             last = self._entries[-1][0] if self._entries else self._start[0]
@@ -362,6 +445,10 @@ class Output:
         names = self._names(k)
         p = sim.particles.numpy()
         written = [str(write_particles_vtu(sim, self.directory / names["particles"], p))]
+        if "elements" in names:
+            written.append(str(write_elements_vtu(sim, self.directory / names["elements"], p)))
+        if "blocks" in names:
+            written.append(str(write_blocks_vtu(sim, self.directory / names["blocks"])))
         if self.walls:
             written.append(str(write_walls_vtu(sim, self.directory / names["walls"])))
         if self.contacts:

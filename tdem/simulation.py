@@ -1182,6 +1182,15 @@ class Simulation:
         """Particle state; ``stress=False`` skips the stress (computed from the contacts)."""
         if not self._built:
             self._build()
+        if self._n == 0:
+            z2 = np.zeros((0, 2))
+            z = np.zeros(0)
+            out = {"position": z2, "velocity": z2, "omega": z, "radius": z, "mass": z,
+                   "force": z2, "torque": z, "displacement": z2}
+            if stress:
+                out.update(stress=np.zeros((0, 2, 2)), stress_zz=z, pressure=z,
+                           plastic_strain=z, strain=np.zeros((0, 3)))
+            return out
         a = self._a
         prop = a["prop"].to_numpy()
         pos = a["pos"].to_numpy()
@@ -1233,6 +1242,11 @@ class Simulation:
         direction (C,2) the unit normal, overlap (C,), point (C,2)."""
         if not self._built:
             self._build()
+        if self._n == 0:
+            return {"pairs": np.zeros((0, 2), np.int64), "normal": np.zeros(0),
+                    "shear": np.zeros(0), "moment": np.zeros(0),
+                    "direction": np.zeros((0, 2)), "overlap": np.zeros(0),
+                    "point": np.zeros((0, 2))}
         a = self._a
         cs = a["cs"].to_numpy()
         nbr = a["nbr"].to_numpy()
