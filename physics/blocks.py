@@ -6,6 +6,14 @@ with no superposition (weight 1), the stress living on the element, and lumped
 nodal masses ρ·S/3. Elastic, Mohr–Coulomb and Fluid materials
 (:mod:`physics.materials`) apply; brittle softening acts per element.
 
+Time integration: at step n the nodes are at x_n and move at v_{n−1/2}, the
+velocities that brought them from x_{n−1}. The velocity gradient (Eq. 6) is taken
+on the mid-step configuration x_n − ½Δt·v_{n−1/2}, halfway through that motion
+(central difference, second order): for a rigid rotation the chord velocities
+then have an exactly skew gradient (the Cayley transform of the rotation), so a
+rigidly rotating body gets no strain at all, whatever the step. The nodal forces
+(Eqs. 13–14) use the current configuration x_n. PCMM elements do the same.
+
 Arrays (all blocks of a simulation concatenated; node indices are global):
 
 - ``tri`` (T,) 3 × i32, counter-clockwise; ``tmat`` (T,) i32 material row;
@@ -36,7 +44,9 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
     for e in range(tri.shape[0]):
         t = tri[e]
         xa, xb, xc = npos[t[0]], npos[t[1]], npos[t[2]]
-        grad = fvm.velocity_gradient(xa, xb, xc, nvel[t[0]], nvel[t[1]], nvel[t[2]])
+        va, vb, vc = nvel[t[0]], nvel[t[1]], nvel[t[2]]
+        h = 0.5 * dt
+        grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
         de = fvm.strain_increment(grad, dt)
         M = tmat[e]
         sig = fvm.jaumann_rotate(tsig[e], fvm.spin_rate(grad), dt) + fvm.elastic_increment(

@@ -26,8 +26,8 @@ Equations
   Δσ_ij = 2G·Δε_ij + (K − 2G/3)·Δθ·δ_ij (i, j in-plane), Δσzz = (K − 2G/3)·Δθ.
 - Jaumann rotation, σ̇ = W·σ − σ·W (so that a stress carried by a rigidly
   rotating body rotates with it: σ = R σ₀ Rᵀ gives σ̇ = Ṙ Rᵀ σ − σ Ṙ Rᵀ with
-  Ṙ Rᵀ = W). Over a step the spin is constant, and the rate is integrated
-  exactly: σ ← R(φ)·σ·R(φ)ᵀ, φ = w·Δt. To first order in Δt this is
+  Ṙ Rᵀ = W). Over a step the stress is turned by the Hughes–Winget rotation
+  σ ← R(φ)·σ·R(φ)ᵀ, tan(φ/2) = w·Δt/2 (φ = w·Δt to second order). To first order in Δt this is
   σ ← σ + (W·σ − σ·W)·Δt; unlike that forward-Euler form it keeps the
   invariants of σ exactly (the Euler form grows the deviator by the factor
   sqrt(1 + (2wΔt)²) each step: 90° in N steps inflates it by ≈ π²/(2N)).
@@ -122,14 +122,18 @@ def elastic_increment(de, K, G):
 
 @ti.func
 def jaumann_rotate(sig, w, dt):
-    """Jaumann rotation over one step, σ ← R(φ)·σ·R(φ)ᵀ with φ = w·Δt: the rate
-    σ̇ = W·σ − σ·W integrated exactly for a constant spin (first order: σ + (Wσ − σW)Δt).
+    """Jaumann rotation over one step, σ ← R(φ)·σ·R(φ)ᵀ with tan(φ/2) = w·Δt/2 (the
+    Hughes–Winget rotation, φ = w·Δt + O(Δt³)): the rate σ̇ = W·σ − σ·W integrated
+    over the step (first order: σ + (Wσ − σW)Δt). With the velocity gradient taken on
+    the mid-step configuration, a rigid rotation by θ per step gives w·Δt = 2 tan(θ/2)
+    exactly, so φ = θ: the stress turns with the body, to round-off.
 
     With d = (σxx − σyy)/2 and τ = σxy, (d, τ) turns by 2φ; the mean (σxx + σyy)/2
     and σzz are unchanged.
     """
-    c = ti.cos(2.0 * w * dt)
-    s = ti.sin(2.0 * w * dt)
+    phi = 2.0 * ti.atan2(0.5 * w * dt, 1.0)
+    c = ti.cos(2.0 * phi)
+    s = ti.sin(2.0 * phi)
     mean = 0.5 * (sig[0] + sig[1])
     d = 0.5 * (sig[0] - sig[1])
     tau = sig[2]

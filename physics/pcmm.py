@@ -718,7 +718,8 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
     1. per particle: Eq. 1 neighbours from the candidates, pruned ring, elements
        (the element set the rules give now: deleted and created in one go);
     2. per element: N_e (probe rule), σ_old = mean of its particles' stresses,
-       Eqs. 6–11 with the Jaumann rotation, the constitutive correction (Eq. 12),
+       Eqs. 6–11 with the Jaumann rotation (velocity gradient on the mid-step
+       configuration, see :mod:`physics.blocks`), the constitutive correction (Eq. 12),
        nodal forces with the weight 1/N_e (Eqs. 13–14, sign fixed);
     3. per particle (gathered, no atomics): force of its elements → xforce,
        stress = mean of its elements' σ (zero in none), strain and plastic shear
@@ -766,7 +767,9 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
             cover = _cover(v0, v1, v2, pos, nbr, ncnt, elem, ecnt)
             ncov[a, s] = cover
             xa, xb, xc = pos[a], pos[b], pos[c]
-            grad = fvm.velocity_gradient(xa, xb, xc, vel[a], vel[b], vel[c])
+            va, vb, vc = vel[a], vel[b], vel[c]
+            h = 0.5 * dt
+            grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
             de = fvm.strain_increment(grad, dt)
             M = pmat[a]
             sig = (psig[a] + psig[b] + psig[c]) / 3.0

@@ -1,0 +1,250 @@
+"""PCMM particles and blocks inside the simulation's time step: patch tests, rigid
+rotation, momentum with elements deleted and created, the element set equal to the
+rules' at every check, DEM contact between bodies that share no element."""
+import numpy as np
+import pytest
+
+import tdem
+from physics.pcmm import ElementSystem, check_rules
+
+E, NU, RHO = 30e9, 0.25, 2500.0
+K = E / (3 * (1 - 2 * NU))
+G = E / (2 * (1 + NU))
+
+
+def packing(kind):
+    if kind == "regular":
+        return tdem.pack.regular(1.0, 0.6, 0.05) + (0.05,)
+    if kind == "cross":
+        return tdem.pack.cross(1.0, 0.6, 0.05) + (0.001,)
+    return tdem.pack.random(1.0, 0.6, 0.03, 0.05, seed=3, target_fraction=0.72) + (0.04,)
+
+
+def hooke(exx, eyy):
+    lam = K - 2 * G / 3
+    return np.array([lam * (exx + eyy) + 2 * G * exx, lam * (exx + eyy) + 2 * G * eyy,
+                     lam * (exx + eyy)])
+
+
+def _stretched(kind, lxx, lyy, steps):
+    """A body whose particles all move with v = L·x0, L = diag(lxx, lyy)."""
+    pos, rad, tol = packing(kind)
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
+    v0 = pos * np.array([lxx, lyy])
+    g = sim.add_particles(pos, rad, material=tdem.Elastic(RHO, E, NU), tolerance=tol,
+                          velocity=v0)
+    sim.fix_particles(g.ids, vx=v0[:, 0], vy=v0[:, 1])
+    sim.run(steps=steps)
+    return sim
+
+
+def _strain_sum(l, dt, steps):
+    # the gradient on the mid-step configuration x0·(1 + (k + ½)·dt·l)
+    k = np.arange(steps)
+    return float(np.sum(l * dt / (1.0 + (k - 0.5) * dt * l)))
+
+
+@pytest.mark.parametrize("kind", ["regular", "cross", "random"])
+def test_patch_uniform_stretch_gives_hooke(kind):
+    lxx, lyy, steps = 2.0, -0.7, 40
+    sim = _stretched(kind, lxx, lyy, steps)
+    p = sim.particles.numpy()
+    inside = p["elements"] > 0
+    assert inside.sum() > 0.8 * len(inside)
+    dt = sim.dt
+    want = hooke(_strain_sum(lxx, dt, steps), _strain_sum(lyy, dt, steps))
+    s = p["stress"][inside]
+    scale = np.abs(want).max()
+    assert np.abs(s[:, 0, 0] - want[0]).max() < 1e-6 * scale
+    assert np.abs(s[:, 1, 1] - want[1]).max() < 1e-6 * scale
+    assert np.abs(s[:, 0, 1]).max() < 1e-6 * scale
+    assert np.abs(p["stress_zz"][inside] - want[2]).max() < 1e-6 * scale
+    # particles in no element carry no stress
+    assert np.all(p["stress"][~inside] == 0.0)
+
+
+def _rotate(points, c, ang):
+    ca, sa = np.cos(ang), np.sin(ang)
+    d = points - c
+    return c + np.stack([ca * d[:, 0] - sa * d[:, 1], sa * d[:, 0] + ca * d[:, 1]], 1)
+
+
+@pytest.mark.parametrize("kind", ["regular", "random"])
+def test_rigid_rotation_90_degrees(kind):
+    """Stretch, hold, then turn the body rigidly by 90°: with no stress before the
+    turn, none after (< 1e-6·E); a stressed body has σxx and σyy swapped."""
+    pos, rad, tol = packing(kind)
+    c = pos.mean(axis=0)
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
+    g = sim.add_particles(pos, rad, material=tdem.Elastic(RHO, E, NU), tolerance=tol)
+    dt = sim.dt
+    nturn = 300
+    w = 0.5 * np.pi / (nturn * dt)
+
+    def chord(t, comp):
+        # velocity that takes the exact rotated positions at t to those at t + dt
+        k = round(t / dt)
+        a0 = w * dt * min(max(k - 20, 0), nturn)
+        a1 = w * dt * min(max(k + 1 - 20, 0), nturn)
+        return (_rotate(pos, c, a1) - _rotate(pos, c, a0))[:, comp] / dt
+
+    sim.fix_particles(g.ids, vx=lambda t: chord(t, 0), vy=lambda t: chord(t, 1))
+    sim.run(steps=nturn + 20)
+    p = sim.particles.numpy()
+    assert np.allclose(p["position"], _rotate(pos, c, 0.5 * np.pi), atol=1e-9)
+    assert np.abs(p["stress"]).max() < 1e-6 * E
+    assert np.abs(p["stress_zz"]).max() < 1e-6 * E
+
+
+def test_prestressed_rotation_swaps_stresses():
+    pos, rad, tol = packing("regular")
+    c = pos.mean(axis=0)
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
+    g = sim.add_particles(pos, rad, material=tdem.Elastic(RHO, E, NU), tolerance=tol)
+    dt = sim.dt
+    nstretch, nturn = 10, 300
+    w = 0.5 * np.pi / (nturn * dt)
+    rate = 1e-5 / (nstretch * dt)       # 1e-5 strain in x over the stretch
+
+    def xk(k):
+        s = 1.0 + rate * dt * min(k, nstretch)
+        base = c + (pos - c) * np.array([s, 1.0])
+        return _rotate(base, c, w * dt * min(max(k - nstretch - 5, 0), nturn))
+
+    def vel(t, comp):
+        k = round(t / dt)
+        return (xk(k + 1) - xk(k))[:, comp] / dt
+
+    sim.fix_particles(g.ids, vx=lambda t: vel(t, 0), vy=lambda t: vel(t, 1))
+    sim.run(steps=nstretch + 3)         # the stretch, then at rest (the step after a
+    p = sim.particles.numpy()           # motion turns it into strain)
+    inside = p["elements"] > 0
+    before = p["stress"][inside].mean(axis=0)
+    sim.run(steps=nturn + 5)
+    after = sim.particles.numpy()["stress"][inside].mean(axis=0)
+    assert before[0, 0] > 1e4                    # a real stress was built
+    scale = abs(before[0, 0])
+    assert abs(after[1, 1] - before[0, 0]) < 1e-6 * scale
+    assert abs(after[0, 0] - before[1, 1]) < 1e-6 * scale
+    assert abs(after[0, 1]) < 1e-6 * scale
+
+
+def _soft_body(seed=1):
+    pos, rad = tdem.pack.random(0.3, 0.3, 0.008, 0.012, seed=seed, target_fraction=0.72)
+    rng = np.random.default_rng(seed)
+    # converging (the body is squeezed, bounces and squeezes again) plus noise
+    vel = rng.normal(0.0, 0.3, pos.shape) - 8.0 * (pos - pos.mean(axis=0))
+    mat = tdem.Elastic(density=1000.0, young=2e4, poisson=0.25)
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.3)
+    sim.add_particles(pos, rad, material=mat, tolerance=0.012, velocity=vel,
+                      contact=tdem.LinearContact(kn=2e4, ks=2e4, friction=0.3))
+    return sim, rad
+
+
+def _momentum(sim):
+    p = sim.particles.numpy(stress=False)
+    mv = p["mass"][:, None] * p["velocity"]
+    return mv.sum(axis=0), np.abs(mv).sum()
+
+
+def test_momentum_conserved_while_elements_die_and_are_born():
+    sim, rad = _soft_body()
+    p0, scale = _momentum(sim)
+    seen = set()
+    born = died = 0
+    prev = None
+    for _ in range(6):
+        sim.run(steps=100)
+        tri = sim.elements.numpy()["triangles"]
+        cur = {tuple(sorted(t)) for t in tri}
+        if prev is not None:
+            born += len(cur - prev)
+            died += len(prev - cur)
+        prev = cur
+        seen |= cur
+        # the element set is exactly the one the rules give for these positions
+        p = sim.particles.numpy(stress=False)
+        x_now = p["position"] - sim.dt * p["velocity"]   # positions the elements were made on
+        ref = ElementSystem(x_now, rad, 0.012).build().numpy()
+        assert cur == {tuple(sorted(t)) for t in ref["triangles"]}
+        assert check_rules(x_now, rad, 0.012, tri)["ok"].all()
+    p1, _ = _momentum(sim)
+    assert born > 50 and died > 50       # elements were deleted and created many times
+    assert np.abs(p1 - p0).max() < 1e-10 * scale
+
+
+def test_bodies_that_share_no_element_collide_through_the_contact_law():
+    """Two PCMM blocks of different materials meet head on: no elements join them,
+    the contact law stops them from passing through each other, momentum holds."""
+    mat_a = tdem.Elastic(density=1000.0, young=1e6, poisson=0.25)
+    mat_b = tdem.Elastic(density=1000.0, young=1e6, poisson=0.25)
+    law = tdem.LinearContact(kn=1e6, ks=1e6, friction=0.0)
+    pa, ra = tdem.pack.regular(0.2, 0.2, 0.01)
+    pb, rb = tdem.pack.regular(0.2, 0.2, 0.01, origin=(0.205, 0.0))
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.3)
+    a = sim.add_particles(pa, ra, material=mat_a, tolerance=0.005, contact=law,
+                          velocity=(1.0, 0.0))
+    b = sim.add_particles(pb, rb, material=mat_b, tolerance=0.005, contact=law,
+                          velocity=(-1.0, 0.0))
+    p0, scale = _momentum(sim)
+    tri = sim.elements.numpy()["triangles"]
+    sim.run(until=0.06)
+    tri = sim.elements.numpy()["triangles"]
+    ia, ib = set(a.ids.tolist()), set(b.ids.tolist())
+    mixed = [t for t in tri if (set(t) & ia) and (set(t) & ib)]
+    assert not mixed
+    p = sim.particles.numpy()
+    xa = p["position"][a.ids, 0].max()
+    xb = p["position"][b.ids, 0].min()
+    assert xb - xa > 0.01                # they did not pass through each other
+    va = p["velocity"][a.ids, 0].mean()
+    assert va < 0.0                       # body a bounced back
+    p1, _ = _momentum(sim)
+    assert np.abs(p1 - p0).max() < 1e-10 * scale
+
+
+def test_block_patch_and_gravity_reaction():
+    """An FVM block under gravity with its base fixed: the base reaction equals the
+    weight (to round-off) once static; a uniform stretch gives Hooke's stress."""
+    v, t = tdem.mesh.rectangle(2.0, 1.0, 8, 4, pattern="cross")
+    sim = tdem.Simulation(gravity=(0.0, -9.81), local_damping=0.8, dt_fraction=0.5)
+    mat = tdem.Elastic(RHO, E, NU)
+    b = sim.add_block(v, t, material=mat)
+    b.fix(b.nodes_in(ymax=1e-9), vx=0.0, vy=0.0)
+    sim.run(steps=3000)
+    nd = b.nodes()
+    weight = RHO * 9.81 * 2.0
+    assert abs(nd["reaction"][:, 1].sum() - weight) < 1e-6 * weight
+    assert abs(nd["mass"].sum() - RHO * 2.0) < 1e-9 * RHO
+
+    sim2 = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
+    b2 = sim2.add_block(v, t, material=mat, velocity=(0.0, 0.0))
+    lxx, lyy = 1.0, 0.3
+    b2.fix(np.arange(len(v)), vx=v[:, 0] * lxx, vy=v[:, 1] * lyy)
+    sim2.run(steps=1)                     # first step: nodes at rest, then moving
+    sim2.run(steps=30)
+    dt = sim2.dt
+    k = np.arange(30)
+    exx = np.sum(lxx * dt / (1.0 + (k + 0.5) * dt * lxx))
+    eyy = np.sum(lyy * dt / (1.0 + (k + 0.5) * dt * lyy))
+    want = hooke(exx, eyy)
+    s = b2.elements()["stress"]
+    assert np.abs(s[:, 0, 0] - want[0]).max() < 1e-6 * abs(want[0])
+    assert np.abs(s[:, 1, 1] - want[1]).max() < 1e-6 * abs(want[0])
+
+
+def test_continuum_inputs():
+    sim = tdem.Simulation()
+    with pytest.raises(ValueError, match="material"):
+        sim.add_particles([[0.0, 0.0]], 0.1, material="rock")
+    with pytest.raises(ValueError, match="tolerance"):
+        sim.add_particles([[0.0, 0.0]], 0.1, material=tdem.Elastic(), tolerance=-1.0)
+    v, t = tdem.mesh.rectangle(1.0, 1.0, 2, 2)
+    with pytest.raises(ValueError, match="inverted"):
+        sim.add_block(v, t[:, ::-1], material=tdem.Elastic())
+    with pytest.raises(ValueError, match="material"):
+        sim.add_block(v, t, material=None)
+    b = sim.add_block(v, t, material=tdem.Elastic())
+    with pytest.raises(ValueError, match="nodes"):
+        b.fix([100], vx=0.0)
+    assert len(sim.blocks) == 1
