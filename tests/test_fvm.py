@@ -110,7 +110,7 @@ def test_patch_stretch_and_spin(pattern):
     st = run_imposed(v, t, L, dt, n)
     A = hooke(np.array([D[0, 0], D[1, 1], D[0, 1]]))     # stress rate C:D
     za = _deviator(A)
-    q = np.exp(2j * w * dt)
+    q = np.exp(2j * 2.0 * np.arctan(0.5 * w * dt))   # Hughes–Winget angle per step
     z_discrete = za * dt * (q ** n - 1) / (q - 1)
     z_exact = za * (np.exp(2j * w * n * dt) - 1) / (2j * w)
     mean = 0.5 * (A[0] + A[1]) * n * dt
