@@ -130,7 +130,10 @@ def test_rigid_rotation(S):
     n = 200
     omega = 0.5 * math.pi           # 90° in 1 s
     dt = 1.0 / n
-    W = np.array([[0.0, -omega], [omega, 0.0]])
+    # spin whose Hughes–Winget angle is exactly omega·dt (what the chord velocities of
+    # an exact rotation give on the mid-step configuration)
+    w_hw = 2.0 * math.tan(0.5 * omega * dt) / dt
+    W = np.array([[0.0, -w_hw], [w_hw, 0.0]])
 
     def rotated(k):
         c, s = math.cos(omega * k * dt), math.sin(omega * k * dt)
