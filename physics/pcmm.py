@@ -634,7 +634,9 @@ def check_rules(positions, radii, tolerance, triangles, rtol=1e-9):
 # indices in the int status array ``pflags``
 P_NEED = 0       # largest number of Eq. 1 candidates of any particle
 P_BUILDS = 1     # engine list build the candidates were made from (−1: none yet)
+P_INC = 2        # largest number of elements containing one particle
 PFLAGS_SIZE = 4
+MAX_INCIDENT = 64  # slots of a particle's list of the elements containing it
 
 
 @ti.kernel
@@ -689,6 +691,45 @@ def candidates(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.
 
 
 @ti.func
+def _cover_incident(v0, v1, v2, pos: ti.template(), elem: ti.template(),
+                    inc: ti.template(), icnt: ti.template(), emult: ti.template()):
+    """:func:`_cover` from the lists of the elements containing each vertex."""
+    p = PROBE[0] * pos[v0] + PROBE[1] * pos[v1] + PROBE[2] * pos[v2]
+    verts = ti.Vector([v0, v1, v2])
+    count = 0
+    for t in ti.static(range(3)):
+        v = verts[t]
+        for q in range(icnt[v]):
+            code = inc[v, q]
+            o = code >> 4
+            s2 = code & 15
+            e1 = elem[o, s2, 0]
+            e2 = elem[o, s2, 1]
+            take = True
+            m = emult[o, s2]
+            for u in ti.static(range(t)):
+                take = take and not _has(o, e1, e2, verts[u])
+            if take:
+                xo = pos[o]
+                x1 = pos[e1]
+                x2 = pos[e2]
+                if _orient(xo, x1, p) > 0.0 and _orient(x1, x2, p) > 0.0 and \
+                        _orient(x2, xo, p) > 0.0:
+                    count += m
+    return count
+
+
+@ti.func
+def _creates(o, x, y, elem: ti.template(), ecnt: ti.template()):
+    """Whether particle o created the element (o, x, y) (same orientation)."""
+    found = False
+    for s in range(ecnt[o]):
+        if elem[o, s, 0] == x and elem[o, s, 1] == y:
+            found = True
+    return found
+
+
+@ti.func
 def _corner(o, e1, e2, i):
     """Which vertex of the element (o, e1, e2) particle i is (0, 1, 2), −1 if none."""
     c = -1
@@ -710,7 +751,9 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
            ncov: ti.types.ndarray(), esig: ti.types.ndarray(), efor: ti.types.ndarray(),
            ede: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
            pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), enbr: ti.types.ndarray(),
-           encnt: ti.types.ndarray(), cskip: ti.types.ndarray(), dt: ti.f64,
+           encnt: ti.types.ndarray(), cskip: ti.types.ndarray(), inc: ti.types.ndarray(),
+           icnt: ti.types.ndarray(), emult: ti.types.ndarray(), pflags: ti.types.ndarray(),
+           dt: ti.f64,
            serial: ti.template()):
     """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16), for the particles of x_n
     moving at v_{n−1/2}:
@@ -751,39 +794,74 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
         else:
             ncnt[i] = 0
             ecnt[i] = 0
-    # 2. element stresses and nodal forces
+    # 1b. copies: a triangle created by k of its vertices is computed once, by the
+    #     copy of the lowest-index creator, with multiplicity k (emult; 0 for the
+    #     other copies). Copies have the same N_e, stress and forces, so every sum
+    #     over elements below weights the computed copy by k.
     ti.loop_config(serialize=serial)
     for a in range(n):
         for s in range(ecnt[a]):
             b = elem[a, s, 0]
             c = elem[a, s, 1]
-            v0, v1, v2 = a, b, c
-            if v0 > v1:
-                v0, v1 = v1, v0
-            if v1 > v2:
-                v1, v2 = v2, v1
-            if v0 > v1:
-                v0, v1 = v1, v0
-            cover = _cover(v0, v1, v2, pos, nbr, ncnt, elem, ecnt)
-            ncov[a, s] = cover
-            xa, xb, xc = pos[a], pos[b], pos[c]
-            va, vb, vc = vel[a], vel[b], vel[c]
-            h = 0.5 * dt
-            grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
-            de = fvm.strain_increment(grad, dt)
-            M = pmat[a]
-            sig = (psig[a] + psig[b] + psig[c]) / 3.0
-            sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
-                de, matp[M, 2], matp[M, 3])
-            failed = 0
-            if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
-                failed = 1
-            sig, eps, flag = mc_correct_state(sig, matp, M, failed)
-            esig[a, s] = sig
-            ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64)])
-            sf = sig + viscous_stress(matp, M, de, dt)
-            fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
-            efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+            mult = 1
+            if _creates(b, c, a, elem, ecnt):
+                mult = 0 if b < a else mult + 1
+            if mult > 0 and _creates(c, a, b, elem, ecnt):
+                mult = 0 if c < a else mult + 1
+            emult[a, s] = mult
+    # 1c. the computed elements containing each particle (owner << 4 | slot): the
+    #     owner is the particle or one of its Eq. 1 neighbours
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        cnt = 0
+        if pmat[i] >= 0:
+            for q in range(ncnt[i] + 1):
+                o = i
+                if q > 0:
+                    o = nbr[i, q - 1]
+                for s in range(ecnt[o]):
+                    if emult[o, s] > 0 and _corner(o, elem[o, s, 0], elem[o, s, 1], i) >= 0:
+                        if cnt < MAX_INCIDENT:
+                            inc[i, cnt] = (o << 4) | s
+                        cnt += 1
+            if cnt > MAX_INCIDENT:
+                ti.atomic_max(pflags[P_INC], cnt)
+                cnt = MAX_INCIDENT
+        icnt[i] = cnt
+    # 2. element stresses and nodal forces
+    ti.loop_config(serialize=serial)
+    for a in range(n):
+        for s in range(ecnt[a]):
+            if emult[a, s] > 0:
+                b = elem[a, s, 0]
+                c = elem[a, s, 1]
+                v0, v1, v2 = a, b, c
+                if v0 > v1:
+                    v0, v1 = v1, v0
+                if v1 > v2:
+                    v1, v2 = v2, v1
+                if v0 > v1:
+                    v0, v1 = v1, v0
+                cover = _cover_incident(v0, v1, v2, pos, elem, inc, icnt, emult)
+                ncov[a, s] = cover
+                xa, xb, xc = pos[a], pos[b], pos[c]
+                va, vb, vc = vel[a], vel[b], vel[c]
+                h = 0.5 * dt
+                grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
+                de = fvm.strain_increment(grad, dt)
+                M = pmat[a]
+                sig = (psig[a] + psig[b] + psig[c]) / 3.0
+                sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+                    de, matp[M, 2], matp[M, 3])
+                failed = 0
+                if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
+                    failed = 1
+                sig, eps, flag = mc_correct_state(sig, matp, M, failed)
+                esig[a, s] = sig
+                ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64)])
+                sf = sig + viscous_stress(matp, M, de, dt)
+                fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
+                efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
     # 3. gather per particle
     ti.loop_config(serialize=serial)
     for i in range(n):
@@ -796,35 +874,35 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
             psum = 0.0
             hit = 0
             cnt = 0
-            for q in range(ncnt[i] + 1):
-                o = i
-                if q > 0:
-                    o = nbr[i, q - 1]
-                for s in range(ecnt[o]):
-                    e1 = elem[o, s, 0]
-                    e2 = elem[o, s, 1]
-                    c = _corner(o, e1, e2, i)
-                    if c >= 0:
-                        fo = efor[o, s]
-                        f += ti.Vector([fo[2 * c], fo[2 * c + 1]])
-                        ssum += esig[o, s]
-                        d = ede[o, s]
-                        dsum += ti.Vector([d[0], d[1], d[2]])
-                        psum += d[3]
-                        if d[4] > 0.0:
-                            hit = 1
-                        cnt += 1
-                        # mark the engine slots of i's partners in this element
-                        for t in ti.static(range(3)):
-                            u = o
-                            if ti.static(t == 1):
-                                u = e1
-                            if ti.static(t == 2):
-                                u = e2
-                            if u > i:
-                                for k in range(encnt[i]):
-                                    if enbr[i, k] == u:
-                                        cskip[i, k] = 1
+            for q in range(icnt[i]):
+                code = inc[i, q]
+                o = code >> 4
+                s = code & 15
+                e1 = elem[o, s, 0]
+                e2 = elem[o, s, 1]
+                c = _corner(o, e1, e2, i)
+                if c >= 0:
+                    mw = emult[o, s]
+                    fo = efor[o, s]
+                    f += mw * ti.Vector([fo[2 * c], fo[2 * c + 1]])
+                    ssum += mw * esig[o, s]
+                    d = ede[o, s]
+                    dsum += mw * ti.Vector([d[0], d[1], d[2]])
+                    psum += mw * d[3]
+                    if d[4] > 0.0:
+                        hit = 1
+                    cnt += mw
+                    # mark the engine slots of i's partners in this element
+                    for t in ti.static(range(3)):
+                        u = o
+                        if ti.static(t == 1):
+                            u = e1
+                        if ti.static(t == 2):
+                            u = e2
+                        if u > i:
+                            for k in range(encnt[i]):
+                                if enbr[i, k] == u:
+                                    cskip[i, k] = 1
             xforce[i] = f
             st = pstate[i]
             if cnt > 0:

@@ -131,6 +131,9 @@ class Continuum:
         a["peps"] = _arr(3, (n,))
         a["pstate"] = _arr(4, (n,))
         a["xforce"] = _arr(2, (n,))
+        a["pinc"] = ti.ndarray(ti.i32, (n, pcmm.MAX_INCIDENT))
+        a["picnt"] = ti.ndarray(ti.i32, (n,))
+        a["emult"] = ti.ndarray(ti.i32, (n, E))
         a["pflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
         a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
         self._alloc_lists()
@@ -275,7 +278,8 @@ class Continuum:
                         a["cand"], a["ccnt"], a["nbr"], a["ncnt"], a["ring"], a["rang"],
                         a["elem"], a["ecnt"], a["earea"], a["ncov"], a["esig"], a["efor"],
                         a["ede"], a["psig"], a["peps"], a["pstate"], a["xforce"], e["nbr"],
-                        e["ncnt"], e["cskip"], float(dt), serial)
+                        e["ncnt"], e["cskip"], a["pinc"], a["picnt"], a["emult"], a["pflags"], float(dt),
+                        serial)
         if self.nv:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
@@ -293,7 +297,12 @@ class Continuum:
 
     def status(self):
         """(candidate slots needed, first unstable node or −1)."""
-        need = int(self.a["pflags"].to_numpy()[pcmm.P_NEED]) if self.has_pcmm else 0
+        flags = self.a["pflags"].to_numpy()
+        if flags[pcmm.P_INC] > pcmm.MAX_INCIDENT:
+            raise CapacityError(f"a PCMM particle belongs to {int(flags[pcmm.P_INC])} elements, "
+                                f"more than {pcmm.MAX_INCIDENT}: is the tolerance far larger "
+                                "than the radii?")
+        need = int(flags[pcmm.P_NEED]) if self.has_pcmm else 0
         bad = -1
         if self.nv:
             b = int(self.a["nflags"].to_numpy()[0])
@@ -339,6 +348,16 @@ class Continuum:
         elem = a["elem"].to_numpy()[owner, slot]
         ncov = a["ncov"].to_numpy()[owner, slot]
         sig = a["esig"].to_numpy()[owner, slot]
+        # copies of a triangle are computed once (the copy with emult > 0): fill the others
+        mult = a["emult"].to_numpy()[owner, slot]
+        key = np.sort(np.column_stack([owner, elem]), axis=1)
+        _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        inv = inv.ravel()
+        comp = np.flatnonzero(mult > 0)
+        src = np.empty(len(first), np.int64)
+        src[inv[comp]] = comp
+        ncov = ncov[src[inv]]
+        sig = sig[src[inv]]
         return {"triangles": np.column_stack([owner, elem]).astype(np.int64),
                 "owner": owner.astype(np.int64),
                 "area": a["earea"].to_numpy()[owner, slot],
