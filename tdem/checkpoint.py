@@ -38,7 +38,7 @@ from .step import WALL_WIDTH
 FORMAT = "tdem-checkpoint"
 VERSION = 1
 _FIX_NAMES = ("vx", "vy", "omega")
-_HOST_KEYS = ("pos", "vel", "radius", "density", "law")
+_HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat")
 
 
 def _config(sim):
@@ -68,6 +68,8 @@ def _config(sim):
         "steps": int(sim._steps),
         "last_fit": int(sim._last_fit),
         "built": bool(sim._built),
+        "slots": [{"material": m.to_dict(), "tolerance": t} for m, t in sim._slots],
+        "continuum_capacity": int(sim._cont.capacity) if sim._cont is not None else 0,
     }
 
 
@@ -78,11 +80,11 @@ def save(sim, path):
     first run would). Returns ``path``.
     """
     import h5py
-    if not sim._built and sim._n > 0:
+    if not sim._built and (sim._n > 0 or sim._blocks):
         sim._build()
-    state = sim._download() if sim._built else {}
+    state = sim._download() if sim._built and sim._n > 0 else {}
     cfg = _config(sim)
-    if sim._built:
+    if sim._built and sim._n > 0:
         cfg["cells"] = [int(sim._a["cell_count"].shape[0]), int(sim._a["cell_start"].shape[0])]
     with h5py.File(str(path), "w") as f:
         f.attrs["format"] = FORMAT
@@ -115,7 +117,37 @@ def save(sim, path):
                                   "particles free", stacklevel=3)
                     continue
                 g.create_dataset(name, data=np.asarray(v, dtype=np.float64))
+        blocks = f.create_group("blocks")
+        for n, b in enumerate(sim._blocks):
+            g = blocks.create_group(f"{n:04d}")
+            g.attrs["slot"] = b.slot
+            g.create_dataset("vertices", data=b.vertices)
+            g.create_dataset("triangles", data=b.triangles)
+            g.create_dataset("velocity", data=b.velocity)
+            for k, (ids, *vals) in enumerate(b._fixes):
+                fg = g.create_group(f"fix{k:04d}")
+                fg.create_dataset("ids", data=np.asarray(ids, dtype=np.int64))
+                for name, v in zip(("vx", "vy"), vals):
+                    if v is None:
+                        continue
+                    if callable(v):
+                        warnings.warn(f"save: the prescribed {name} of fix call {k} of block {n} "
+                                      "is a function and cannot be saved; the loaded "
+                                      f"simulation leaves {name} of these nodes free",
+                                      stacklevel=3)
+                        continue
+                    fg.create_dataset(name, data=np.asarray(v, dtype=np.float64))
+        if sim._cont is not None:
+            cg = f.create_group("continuum")
+            for k, arr in sim._cont.a.items():
+                if k in _CONTINUUM_STATE:
+                    cg.create_dataset(k, data=arr.to_numpy())
     return path
+
+
+# the continuum's state (the rest is set up again from the host description)
+_CONTINUUM_STATE = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags", "npos",
+                    "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags")
 
 
 def load(path, arch=None):
@@ -130,7 +162,10 @@ def load(path, arch=None):
 
     from physics.contact_law import ContactLaw
 
-    from .simulation import ParticleGroup, Simulation
+    from physics.materials import Material
+
+    from .continuum import Continuum
+    from .simulation import Block, ParticleGroup, Simulation
 
     with h5py.File(str(path), "r") as f:
         if f.attrs.get("format") != FORMAT:
@@ -142,6 +177,17 @@ def load(path, arch=None):
         cfg = json.loads(f.attrs["config"])
         state = {k: d[()] for k, d in f["state"].items()}
         host = {k: f["host"][k][()] for k in f["host"]}
+        blocks = []
+        for key in sorted(f["blocks"]) if "blocks" in f else []:
+            g = f["blocks"][key]
+            bfix = []
+            for fk in sorted(x for x in g if x.startswith("fix")):
+                fg = g[fk]
+                bfix.append((fg["ids"][()], *[fg[nm][()] if nm in fg else None
+                                              for nm in ("vx", "vy")]))
+            blocks.append((int(g.attrs["slot"]), g["vertices"][()], g["triangles"][()],
+                           g["velocity"][()], bfix))
+        cstate = ({k: d[()] for k, d in f["continuum"].items()} if "continuum" in f else {})
         fixes = []
         for key in sorted(f["fixes"]):
             g = f["fixes"][key]
@@ -158,9 +204,17 @@ def load(path, arch=None):
     sim._pair_override = {(a, b): c for a, b, c in cfg["pair_override"]}
 
     offsets = np.concatenate([[0], np.cumsum(host["sizes"])]).astype(np.int64)
+    if "mat" not in host and "radius" in host:
+        host["mat"] = np.full(len(host["radius"]), -1)
     for k in _HOST_KEYS:
         sim._host[k] = ([np.array(host[k][a:b]) for a, b in zip(offsets[:-1], offsets[1:])]
                         if k in host else [])
+    sim._slots = [(Material.from_dict(d["material"]), d["tolerance"])
+                  for d in cfg.get("slots", [])]
+    for k, (slot, x, t, vel, bfix) in enumerate(blocks):
+        b = Block(sim, k, x, t, sim._slots[slot][0], slot, vel)
+        b._fixes = bfix
+        sim._blocks.append(b)
     for gd, rho in zip(cfg["groups"], sim._host["density"]):
         ids = np.arange(gd["first"], gd["first"] + gd["count"])
         sim._groups.append(ParticleGroup(sim, ids, sim._laws[gd["law"]], rho))
@@ -172,8 +226,28 @@ def load(path, arch=None):
     sim._time = cfg["time"]
     sim._steps = cfg["steps"]
 
+    if cfg["built"] and sim._slots:
+        if sim._n:
+            pos = np.concatenate(sim._host["pos"])
+            rad = np.concatenate(sim._host["radius"])
+            pmat = np.concatenate(sim._host["mat"]).astype(np.int64)
+        else:
+            pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
+        sim._cont = Continuum(pos, rad, pmat, sim._slots, sim._blocks)
+        cap = cfg.get("continuum_capacity", 0)
+        if cap > sim._cont.capacity:
+            sim._cont.capacity = cap
+            sim._cont._alloc_lists()
     if cfg["built"] and state:
         _restore_device(sim, state, cfg)
+    elif cfg["built"] and sim._blocks:
+        sim._build()
+    if sim._cont is not None:
+        for k, v in cstate.items():
+            arr = sim._cont.a.get(k)
+            if arr is not None and tuple(arr.shape) == v.shape[:len(arr.shape)]:
+                arr.from_numpy(np.ascontiguousarray(v))
+        sim._cont.apply_node_fixes(sim._time, initial=True)
     sim._last_fit = cfg["last_fit"]
     return sim
 
