@@ -1,4 +1,5 @@
-"""Structured triangle meshes of rectangles, and mesh checks (numpy).
+"""Triangle meshes: structured meshes of rectangles, Delaunay meshes of polygons, and
+mesh checks (numpy).
 
 Conventions
 -----------
@@ -72,6 +73,68 @@ def rectangle(width, height, nx, ny, pattern="regular", origin=(0.0, 0.0)):
         tris = np.stack([np.stack([p00, p10, pc], 1), np.stack([p10, p11, pc], 1),
                          np.stack([p11, p01, pc], 1), np.stack([p01, p00, pc], 1)], 1)
     return verts, tris.reshape(-1, 3).astype(np.int64)
+
+
+def polygon(points, size):
+    """Triangle mesh of the simple polygon ``points`` (M, 2) with edges about ``size``.
+
+    Nodes: the polygon's corners, points every ≈ ``size`` along its sides, and a
+    hexagonal lattice of spacing ``size`` inside, kept at least 0.5·size from the
+    sides. Triangles: the Delaunay triangulation of these nodes (Qhull, through
+    matplotlib) whose centroids lie inside the polygon; concave polygons are
+    handled that way. Returns ``(vertices (V, 2), triangles (T, 3))``,
+    counter-clockwise, checked by :func:`check_mesh`.
+    """
+    import matplotlib.path as mpath
+    import matplotlib.tri as mtri
+
+    h = _positive("size", size)
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"points must be an array (M, 2) of numbers, got {points!r}") from None
+    if p.ndim != 2 or p.shape[1] != 2 or len(p) < 3 or not np.isfinite(p).all():
+        raise InputError(f"points must be a finite array (M, 2) with M >= 3, got shape "
+                         f"{p.shape}")
+    area2 = np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+    if abs(area2) <= 1e-12 * np.ptp(p, axis=0).max() ** 2:
+        raise InputError("points: the polygon has no area")
+    if area2 < 0:
+        p = p[::-1]
+    nodes = []
+    for a, b in zip(p, np.roll(p, -1, axis=0)):
+        k = max(1, int(np.ceil(np.linalg.norm(b - a) / h)))
+        s = np.arange(k)[:, None] / k
+        nodes.append(a + s * (b - a))
+    boundary = np.concatenate(nodes)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    dy = h * np.sqrt(3.0) / 2.0
+    ys = np.arange(lo[1], hi[1] + dy, dy)
+    xs = []
+    for j, y in enumerate(ys):
+        x = np.arange(lo[0] + (0.5 * h if j % 2 else 0.0), hi[0] + h, h)
+        xs.append(np.stack([x, np.full(len(x), y)], 1))
+    grid = np.concatenate(xs)
+    path = mpath.Path(p)
+    keep = path.contains_points(grid)
+    grid = grid[keep]
+    # distance to the sides
+    d = np.full(len(grid), np.inf)
+    for a, b in zip(p, np.roll(p, -1, axis=0)):
+        ab = b - a
+        s = np.clip(((grid - a) @ ab) / (ab @ ab), 0.0, 1.0)
+        d = np.minimum(d, np.linalg.norm(grid - (a + s[:, None] * ab), axis=1))
+    grid = grid[d >= 0.5 * h]
+    x = np.concatenate([boundary, grid])
+    tri = mtri.Triangulation(x[:, 0], x[:, 1]).triangles.astype(np.int64)
+    cent = x[tri].mean(axis=1)
+    tri = tri[path.contains_points(cent)]
+    sa = signed_areas(x, tri)
+    tri[sa < 0] = tri[sa < 0][:, ::-1]
+    used = np.unique(tri)
+    remap = -np.ones(len(x), np.int64)
+    remap[used] = np.arange(len(used))
+    return check_mesh(x[used], remap[tri])
 
 
 def signed_areas(vertices, triangles):

@@ -102,3 +102,32 @@ def test_check_mesh_rejects_inverted_and_degenerate():
         mesh.rectangle(1.0, 1.0, 0, 2)
     with pytest.raises(InputError):
         mesh.rectangle(1.0, 1.0, 2, 2, pattern="diamond")
+
+
+@pytest.mark.parametrize("pts,area", [
+    ([[0, 0], [1, 0], [1, 1], [0.5, 0.4], [0, 1]], 0.7),          # concave
+    ([[0, 0], [0.6, 0.0], [0.6 + 0.02, 0.04], [0.02, 0.04]], 0.024),  # thin inclined plate
+])
+def test_polygon_mesh_covers_the_polygon(pts, area):
+    v, t = mesh.polygon(pts, 0.02)
+    s = mesh.signed_areas(v, t)
+    assert s.min() > 0
+    assert abs(s.sum() - area) < 1e-12
+    # no sliver: every interior angle above 15 degrees
+    p = v[t]
+    e = np.roll(p, -1, axis=1) - p
+    u, w = e, -np.roll(e, 1, axis=1)
+    cos = np.einsum("eki,eki->ek", u, w) / (np.linalg.norm(u, axis=2) * np.linalg.norm(w, axis=2))
+    assert np.degrees(np.arccos(np.clip(cos, -1, 1))).min() > 15.0
+    # the boundary loop has the polygon's perimeter
+    b = mesh.boundary_edges(t)
+    q = np.asarray(pts, float)
+    perim = np.linalg.norm(np.roll(q, -1, 0) - q, axis=1).sum()
+    assert abs(np.linalg.norm(v[b[:, 1]] - v[b[:, 0]], axis=1).sum() - perim) < 1e-9
+
+
+def test_polygon_mesh_bad_input():
+    with pytest.raises(ValueError, match="size"):
+        mesh.polygon([[0, 0], [1, 0], [0, 1]], -1.0)
+    with pytest.raises(ValueError, match="points"):
+        mesh.polygon([[0, 0], [1, 0]], 0.1)
