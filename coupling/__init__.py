@@ -1,1 +1,4 @@
-"""Particle–block and block–block point–edge contacts (planned)."""
+"""Particle–block and block–block point–edge contacts."""
+from .point_edge import PointEdge
+
+__all__ = ["PointEdge"]

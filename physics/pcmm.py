@@ -916,6 +916,8 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 st[1] = 1.0
             st[2] = ti.cast(cnt, ti.f64)
             pstate[i] = st
+        else:
+            xforce[i] = ti.Vector([0.0, 0.0])
 
 
 @ti.func

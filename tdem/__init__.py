@@ -6,6 +6,7 @@ continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
 :class:`InputError`, :class:`InstabilityError`.
 """
+from coupling import PointEdge
 from physics import HertzMindlin, LinearContact, RollingResistance
 from physics.materials import Elastic, Fluid, MohrCoulomb
 
@@ -16,5 +17,5 @@ from .simulation import Block, ParticleGroup, Simulation, Wall
 __version__ = "0.1.0"
 
 __all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "LinearContact", "HertzMindlin",
-           "RollingResistance", "Elastic", "MohrCoulomb", "Fluid", "InputError",
+           "RollingResistance", "PointEdge", "Elastic", "MohrCoulomb", "Fluid", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack"]

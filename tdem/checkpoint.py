@@ -70,6 +70,8 @@ def _config(sim):
         "built": bool(sim._built),
         "slots": [{"material": m.to_dict(), "tolerance": t} for m, t in sim._slots],
         "continuum_capacity": int(sim._cont.capacity) if sim._cont is not None else 0,
+        "couples": [{"ids": [int(i) for i in ids], "block": int(b.index), "law": law.to_dict()}
+                    for ids, b, law in sim._couples],
     }
 
 
@@ -147,7 +149,8 @@ def save(sim, path):
 
 # the continuum's state (the rest is set up again from the host description)
 _CONTINUUM_STATE = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags", "npos",
-                    "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags")
+                    "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags", "sedge",
+                    "sforce", "sbroken")
 
 
 def load(path, arch=None):
@@ -215,6 +218,9 @@ def load(path, arch=None):
         b = Block(sim, k, x, t, sim._slots[slot][0], slot, vel)
         b._fixes = bfix
         sim._blocks.append(b)
+    from coupling.point_edge import PointEdge
+    sim._couples = [(np.asarray(c["ids"], np.int64), sim._blocks[c["block"]],
+                     PointEdge(**c["law"])) for c in cfg.get("couples", [])]
     for gd, rho in zip(cfg["groups"], sim._host["density"]):
         ids = np.arange(gd["first"], gd["first"] + gd["count"])
         sim._groups.append(ParticleGroup(sim, ids, sim._laws[gd["law"]], rho))
@@ -233,7 +239,8 @@ def load(path, arch=None):
             pmat = np.concatenate(sim._host["mat"]).astype(np.int64)
         else:
             pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
-        sim._cont = Continuum(pos, rad, pmat, sim._slots, sim._blocks)
+        sim._cont = Continuum(pos, rad, pmat, sim._slots, sim._blocks,
+                              couples=sim._couple_rows())
         cap = cfg.get("continuum_capacity", 0)
         if cap > sim._cont.capacity:
             sim._cont.capacity = cap

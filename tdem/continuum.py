@@ -19,6 +19,7 @@ import math
 import numpy as np
 import taichi as ti
 
+from coupling import point_edge as pe
 from physics import blocks as blk
 from physics import pcmm
 from physics.materials import MAT_WIDTH
@@ -33,7 +34,8 @@ MAX_CANDIDATES = 1024
 
 # arrays copied into the run segment's snapshot (the dynamic state)
 _SNAP = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags",
-         "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags")
+         "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
+         "sedge", "sforce", "sbroken")
 
 
 @ti.kernel
@@ -98,7 +100,7 @@ class Continuum:
     blocks : list of :class:`tdem.simulation.Block`
     """
 
-    def __init__(self, pos, rad, pmat, slots, blocks, capacity=16):
+    def __init__(self, pos, rad, pmat, slots, blocks, capacity=16, couples=()):
         self.n = len(rad)
         self.slots = slots
         self.blocks = blocks
@@ -138,6 +140,7 @@ class Continuum:
         a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
         self._alloc_lists()
         self._setup_blocks()
+        self._setup_couples(couples)
         self.snap = {}
 
     # ------------------------------------------------------------------ set-up
@@ -221,6 +224,38 @@ class Continuum:
         a["inc"].from_numpy(inc)
         self.apply_node_fixes(0.0, initial=True)
 
+    def _setup_couples(self, couples):
+        """Point–edge couples: rows (particle, couple), the blocks' boundary edges,
+        one law row per couple (stiffnesses resolved by the simulation)."""
+        a = self.a
+        parts, cpl, ranges, edges, laws = [], [], [], [], []
+        e0 = 0
+        for k, (ids, block, law, kn, ks) in enumerate(couples):
+            be = _boundary_edges(block.triangles) + block._offset
+            parts.append(np.asarray(ids, np.int32))
+            cpl.append(np.full(len(ids), k, np.int32))
+            ranges.append((e0, e0 + len(be)))
+            edges.append(be)
+            e0 += len(be)
+            laws.append(law.row(kn, ks))
+        self.nq = int(sum(len(p) for p in parts))
+        q = max(self.nq, 1)
+        a["cpart"] = ti.ndarray(ti.i32, (q,))
+        a["ccpl"] = ti.ndarray(ti.i32, (q,))
+        a["crange"] = ti.ndarray(ti.i32, (max(len(ranges), 1), 2))
+        a["cedges"] = ti.ndarray(ti.i32, (max(e0, 1), 2))
+        a["claw"] = ti.ndarray(ti.f64, (max(len(laws), 1), pe.LAW_WIDTH))
+        a["sedge"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
+        a["sforce"] = _arr(2, (q, pe.SLOTS))
+        a["sbroken"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
+        a["sedge"].from_numpy(-np.ones((q, pe.SLOTS), np.int32))
+        if self.nq:
+            a["cpart"].from_numpy(np.concatenate(parts))
+            a["ccpl"].from_numpy(np.concatenate(cpl))
+            a["crange"].from_numpy(np.array(ranges, np.int32))
+            a["cedges"].from_numpy(np.concatenate(edges).astype(np.int32))
+            a["claw"].from_numpy(np.array(laws, float))
+
     def upload_materials(self):
         rows = np.zeros((max(len(self.slots), 1), MAT_WIDTH))
         tol = np.zeros(max(len(self.slots), 1))
@@ -284,6 +319,17 @@ class Continuum:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
                        float(dt), serial)
+        if self.nq:
+            if not self.has_pcmm:
+                a["xforce"].fill(0.0)
+            pe.point_edge(e["pos"], e["vel"], e["prop"], a["npos"], a["nvel"], a["cpart"],
+                          a["ccpl"], a["crange"], a["cedges"], a["claw"], a["sedge"],
+                          a["sforce"], a["sbroken"], a["xforce"], a["nforce"], float(dt))
+
+    @property
+    def adds_forces(self):
+        """Whether the particles get forces from here (elements or point–edge contacts)."""
+        return self.has_pcmm or self.nq > 0
 
     def _fix_fn_nodes(self):
         return self.nv and getattr(self, "_fix_fn", False)
@@ -392,6 +438,11 @@ class Continuum:
         return {"triangles": b.triangles.copy(), "stress": _tensor(sig),
                 "stress_zz": sig[:, 3].copy(), "plastic_strain": st[:, 0].copy(),
                 "failed": st[:, 1] > 0.5}
+
+
+def _boundary_edges(triangles):
+    from .mesh import boundary_edges
+    return boundary_edges(triangles)
 
 
 def _tensor(s4):

@@ -350,6 +350,7 @@ class Simulation:
         self._slots = []           # (material, tolerance) of PCMM bodies and blocks
         self._blocks = []
         self._cont = None          # Continuum (PCMM elements, blocks) once built
+        self._couples = []         # (particle ids, block, PointEdge)
         self._walls_host = []      # rows of the wall table
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
@@ -496,6 +497,49 @@ class Simulation:
     def blocks(self):
         return list(self._blocks)
 
+    def couple(self, a, b, law):
+        """Point–edge contacts (``tdem.PointEdge``) between the particles ``a`` (a
+        :class:`ParticleGroup` or particle indices) and the boundary edges of the
+        block ``b`` (Feng et al. §2.6). Must be called before the first run."""
+        from coupling.point_edge import PointEdge
+        if not isinstance(law, PointEdge):
+            raise InputError(f"law must be a tdem.PointEdge(...), got {law!r}")
+        if not isinstance(b, Block) or b._sim is not self:
+            raise InputError(f"b must be a block of this simulation (from add_block), got {b!r}")
+        if isinstance(a, Block):
+            raise InputError("a: block–block contacts are not available in this version; "
+                             "couple particles with a block")
+        ids = a.ids if isinstance(a, ParticleGroup) else np.atleast_1d(np.asarray(a))
+        ids = np.asarray(ids, dtype=np.int64)
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
+            raise InputError(f"a must be particles of this simulation (indices in "
+                             f"[0, {self._n})), got {ids.tolist()[:8]}")
+        if self._built:
+            raise InputError("a: couples must be set up before the first run")
+        self._couples.append((ids, b, law))
+
+    def _couple_rows(self):
+        """Couples with their stiffnesses resolved (PointEdge docstring)."""
+        rows = []
+        laws = np.concatenate(self._host["law"]) if self._n else np.zeros(0, int)
+        mats = np.concatenate(self._host["mat"]) if self._n else np.zeros(0, int)
+        for ids, b, law in self._couples:
+            cands = [(b.material.young if hasattr(b.material, "young") else 3 * b.material.bulk,
+                      getattr(b.material, "poisson", 0.5))]
+            for slot in np.unique(mats[ids]):
+                if slot >= 0:
+                    m = self._slots[slot][0]
+                    cands.append((getattr(m, "young", 3 * m.bulk), getattr(m, "poisson", 0.5)))
+            for lid in np.unique(laws[ids]):
+                kn_law = getattr(self._laws[lid], "kn", None)
+                if kn_law is not None:
+                    cands.append((kn_law, 0.25))
+            e, nu = max(cands)
+            kn = law.kn if law.kn is not None else e
+            ks = law.ks if law.ks is not None else kn / (2.0 * (1.0 + nu))
+            rows.append((ids, b, law, kn, ks))
+        return rows
+
     def particles_in(self, xmin=-np.inf, xmax=np.inf, ymin=-np.inf, ymax=np.inf):
         """Indices of the particles whose centres lie in the box (now)."""
         if self._n == 0:
@@ -635,6 +679,11 @@ class Simulation:
         if self._slots:
             self._require_built()
         crit = self._cont.critical_dt() if self._cont is not None else np.inf
+        for ids, b, law, kn, ks in (self._couple_rows() if self._couples else []):
+            nm = self._cont.a["nmass"].to_numpy()[b._offset:b._offset + len(b)]
+            m = min(float(nm.min()), float(self._a["prop"].to_numpy()[ids, 1].min())
+                    if self._n else np.inf)
+            crit = min(crit, 2.0 * math.sqrt(m / max(kn, ks)))
         if self._n == 0:
             if self._blocks:
                 return crit
@@ -736,7 +785,8 @@ class Simulation:
                 pmat = np.concatenate(self._host["mat"]).astype(np.int64)
             else:
                 pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
-            self._cont = Continuum(pos, rad, pmat, self._slots, self._blocks)
+            self._cont = Continuum(pos, rad, pmat, self._slots, self._blocks,
+                                   couples=self._couple_rows())
         if self._n == 0:
             # blocks only: no particle arrays, the engine's parameters only
             self._a = {"simp": ti.ndarray(ti.f64, (stepk.SIMP_SIZE,))}
@@ -964,7 +1014,7 @@ class Simulation:
         if cont is not None:
             cont.before_forces(self, self._dt_run, self._reach)
         if self._n:
-            stepk.step(*step_args, detail, cont is not None and cont.has_pcmm)
+            stepk.step(*step_args, detail, cont is not None and cont.adds_forces)
         if cont is not None:
             cont.after_step(self)
         self._time += self._dt_run

@@ -1,0 +1,157 @@
+"""Point–edge contacts between particles and block boundary edges (Feng et al. §2.6,
+Eqs. 17–24, as decided in the physics notes §5).
+
+Geometry: the boundary edge i→j of a block (counter-clockwise mesh, the block to
+its left) has the unit tangent t = (x_j − x_i)/|x_j − x_i| and the outward normal
+n = (t_y, −t_x). A particle p of radius R touches the edge when the projection
+k of its centre falls on the edge, s = (x_p − x_i)·t/|x_j − x_i| ∈ [0, 1) (half
+open, so that a particle above a node shared by two edges of a flat side touches
+one of them, not both), and
+its distance d = |(x_p − x_i)·n| < R. Weights w_i = 1 − s = d_jk/d_ij,
+w_j = s = d_ik/d_ij.
+
+Law (incremental springs in the edge frame, compression-positive F_n):
+    Δd = [v_p − (w_i v_i + w_j v_j)]·Δt
+    F_n ← F_n − K_n·(Δd·n),  F_s ← F_s − K_s·(Δd·t)
+    A = 2R × 1 m. If −F_n ≥ T·A the contact breaks (F = 0); if
+    |F_s| ≥ F_n·tan φ + C·A, F_s is capped there; after either, C = T = 0 for
+    that contact (it stays frictional).
+    The particle gets F = F_n·n + F_s·t, the nodes −w_i·F and −w_j·F: linear
+    momentum is conserved exactly. The force acts at the particle centre (no
+    moment), as in the paper.
+
+A new contact starts with F_n = F_s = 0 (the springs are incremental); a contact
+whose particle leaves the edge is forgotten. Each coupled particle keeps up to
+``SLOTS`` contacts (edge index, F_n, F_s, broken flag) carried from step to step.
+"""
+import math
+
+import taichi as ti
+
+from physics.validate import in_range, non_negative, positive
+
+SLOTS = 4
+# columns of the law table (one row per couple)
+L_KN, L_KS, L_TAN, L_C, L_T = 0, 1, 2, 3, 4
+LAW_WIDTH = 5
+
+
+class PointEdge:
+    """Point–edge contact law between particles (or block nodes) and block edges.
+
+    Parameters
+    ----------
+    kn, ks : normal and shear stiffness K_n, K_s (N/m per metre of thickness).
+        None: set when the contact is coupled, from the stiffer of the two sides:
+        K_n = its Young's modulus E (a 2D contact over the particle's width is as
+        stiff as E per metre of thickness), K_s = K_n/(2(1 + ν)). A plain disc
+        (no material) counts with its contact law's k_n as its E (ν = 0.25).
+    friction_angle : φ in degrees, [0, 90)
+    cohesion : C (Pa), ≥ 0, acting on A = 2R
+    tensile_strength : T (Pa), ≥ 0, acting on A = 2R
+    """
+
+    def __init__(self, kn=None, ks=None, friction_angle=20.0, cohesion=0.0,
+                 tensile_strength=0.0):
+        self.kn = None if kn is None else positive("kn", kn)
+        self.ks = None if ks is None else non_negative("ks", ks)
+        self.friction_angle = in_range("friction_angle", friction_angle, 0.0, 90.0,
+                                       hi_open=True)
+        self.cohesion = non_negative("cohesion", cohesion)
+        self.tensile_strength = non_negative("tensile_strength", tensile_strength)
+
+    def row(self, kn, ks):
+        return [kn, ks, math.tan(math.radians(self.friction_angle)), self.cohesion,
+                self.tensile_strength]
+
+    def to_dict(self):
+        return {"kn": self.kn, "ks": self.ks, "friction_angle": self.friction_angle,
+                "cohesion": self.cohesion, "tensile_strength": self.tensile_strength}
+
+    def __repr__(self):
+        return "PointEdge(" + ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items()) + ")"
+
+
+@ti.kernel
+def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarray(),
+               npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
+               cpart: ti.types.ndarray(), ccpl: ti.types.ndarray(),
+               crange: ti.types.ndarray(), edges: ti.types.ndarray(),
+               claw: ti.types.ndarray(), sedge: ti.types.ndarray(),
+               sforce: ti.types.ndarray(), sbroken: ti.types.ndarray(),
+               xforce: ti.types.ndarray(), nforce: ti.types.ndarray(), dt: ti.f64):
+    """Contacts of every coupled particle row q (particle cpart[q] with the edges
+    crange[ccpl[q]] of its block): forces added to ``xforce`` (particles) and
+    ``nforce`` (nodes). Slots: sedge (edge or −1), sforce (F_n, F_s), sbroken."""
+    for q in range(cpart.shape[0]):
+        p = cpart[q]
+        c = ccpl[q]
+        x = pos[p]
+        v = vel[p]
+        R = prop[p][0]
+        kn = claw[c, L_KN]
+        ks = claw[c, L_KS]
+        tanf = claw[c, L_TAN]
+        # the slots of the previous step, read before they are rewritten
+        old_e = ti.Vector([sedge[q, k] for k in ti.static(range(SLOTS))])
+        old_f = ti.Matrix([[sforce[q, k][0], sforce[q, k][1]] for k in ti.static(range(SLOTS))])
+        old_b = ti.Vector([sbroken[q, k] for k in ti.static(range(SLOTS))])
+        cnt = 0
+        ftot = ti.Vector([0.0, 0.0])
+        for e in range(crange[c, 0], crange[c, 1]):
+            a = edges[e, 0]
+            b = edges[e, 1]
+            xi = npos[a]
+            xj = npos[b]
+            ev = xj - xi
+            L = ev.norm()
+            t = ev / L
+            n = ti.Vector([t[1], -t[0]])
+            r = x - xi
+            s = r.dot(t) / L
+            d = r.dot(n)
+            if s >= 0.0 and s < 1.0 and ti.abs(d) < R and cnt < SLOTS:
+                fn = 0.0
+                fs = 0.0
+                broken = 0
+                for k in ti.static(range(SLOTS)):
+                    if old_e[k] == e:
+                        fn = old_f[k, 0]
+                        fs = old_f[k, 1]
+                        broken = old_b[k]
+                wi = 1.0 - s
+                wj = s
+                dd = (v - (wi * nvel[a] + wj * nvel[b])) * dt
+                fn -= kn * dd.dot(n)
+                fs -= ks * dd.dot(t)
+                area = 2.0 * R
+                coh = claw[c, L_C]
+                ten = claw[c, L_T]
+                if broken != 0:
+                    coh = 0.0
+                    ten = 0.0
+                if -fn >= ten * area:
+                    fn = 0.0
+                    fs = 0.0
+                    broken = 1
+                else:
+                    cap = fn * tanf + coh * area
+                    if ti.abs(fs) >= cap:
+                        fs = ti.math.sign(fs) * ti.max(cap, 0.0)
+                        broken = 1
+                f = fn * n + fs * t
+                ftot += f
+                ti.atomic_add(nforce[a][0], -wi * f[0])
+                ti.atomic_add(nforce[a][1], -wi * f[1])
+                ti.atomic_add(nforce[b][0], -wj * f[0])
+                ti.atomic_add(nforce[b][1], -wj * f[1])
+                sedge[q, cnt] = e
+                sforce[q, cnt] = ti.Vector([fn, fs])
+                sbroken[q, cnt] = broken
+                cnt += 1
+        for k in range(cnt, SLOTS):
+            sedge[q, k] = -1
+            sforce[q, k] = ti.Vector([0.0, 0.0])
+            sbroken[q, k] = 0
+        ti.atomic_add(xforce[p][0], ftot[0])
+        ti.atomic_add(xforce[p][1], ftot[1])

@@ -1,0 +1,149 @@
+"""Point–edge contacts between particles and blocks (Feng et al. §2.6)."""
+import math
+
+import numpy as np
+import pytest
+
+import tdem
+
+G = 9.81
+
+
+def _rotated_block(angle_deg, length=2.0, thick=0.2):
+    """A rectangle whose top edge is inclined at ``angle_deg``; returns the mesh and
+    the top-edge direction."""
+    v, t = tdem.mesh.rectangle(length, thick, 10, 1, origin=(-0.5 * length, -thick))
+    a = math.radians(angle_deg)
+    rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+    return v @ rot.T, t, rot @ np.array([1.0, 0.0]), rot @ np.array([0.0, 1.0])
+
+
+def _disc_on(angle_deg, friction_angle, damping=0.0):
+    v, t, tang, nrm = _rotated_block(angle_deg)
+    sim = tdem.Simulation(gravity=(0.0, -G), local_damping=damping, dt_fraction=0.5)
+    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e8, 0.25))
+    block.fix(np.arange(len(v)), vx=0.0, vy=0.0)
+    r = 0.05
+    disc = sim.add_particles([nrm * r], r, density=2000.0,
+                             contact=tdem.LinearContact(kn=1e7, friction=0.5))
+    sim.couple(disc, block, tdem.PointEdge(kn=1e7, ks=1e7, friction_angle=friction_angle))
+    return sim, block, tang, nrm
+
+
+def test_disc_resting_on_a_block_carries_its_weight():
+    sim, block, _, _ = _disc_on(0.0, 30.0, damping=0.7)
+    sim.run(until=0.5)
+    p = sim.particles.numpy()
+    w = p["mass"][0] * G
+    assert p["force"][0, 1] == pytest.approx(w, rel=5e-3)
+    nd = block.nodes()
+    # the block's supports carry its own weight and the disc's
+    assert nd["reaction"][:, 1].sum() == pytest.approx(nd["mass"].sum() * G + w, rel=5e-3)
+    # the block receives −F from the disc
+    assert nd["force"][:, 1].sum() - 0.0 == pytest.approx(-w, rel=5e-3)
+
+
+def test_disc_slides_down_a_30_degree_edge_at_the_coulomb_rate():
+    sim, _, tang, _ = _disc_on(30.0, 20.0)
+    sim.run(until=0.05)
+    x0 = sim.particles.numpy()["position"][0] @ tang
+    v0 = sim.particles.numpy()["velocity"][0] @ tang
+    t0 = sim.time
+    sim.run(until=0.45)
+    p = sim.particles.numpy()
+    dt = sim.time - t0
+    # along the slope s = v0·t + a t²/2 (downhill is −tang)
+    a = 2.0 * ((p["position"][0] @ tang) - x0 - v0 * dt) / dt ** 2
+    want = -G * (math.sin(math.radians(30)) - math.cos(math.radians(30)) *
+                 math.tan(math.radians(20)))
+    assert a == pytest.approx(want, rel=0.02)
+
+
+def test_disc_stays_on_a_15_degree_edge():
+    sim, _, tang, _ = _disc_on(15.0, 20.0)
+    sim.run(until=0.4)
+    p = sim.particles.numpy()
+    # it moves no more than the elastic give of the shear spring, m g sin θ / K_s
+    give = p["mass"][0] * G * math.sin(math.radians(15)) / 1e7
+    assert abs(p["position"][0] @ tang) < 3 * give   # (it oscillates on the spring)
+    sim.run(until=0.8)
+    assert abs(sim.particles.numpy()["position"][0] @ tang) < 3 * give
+
+
+def test_cohesive_contact_breaks_in_tension_at_t_times_a_then_stays_weak():
+    v, t, _, _ = _rotated_block(0.0)
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt=1e-5)
+    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e9, 0.25))
+    block.fix(np.arange(len(v)), vx=0.0, vy=0.0)
+    r, T = 0.05, 1e4
+    disc = sim.add_particles([[0.0, 0.9 * r]], r, density=2000.0,
+                             contact=tdem.LinearContact(kn=1e7))
+    sim.couple(disc, block, tdem.PointEdge(kn=1e7, ks=1e7, friction_angle=30.0,
+                                           cohesion=2e4, tensile_strength=T))
+    sim.fix_particles(disc.ids, vx=0.0, vy=0.01)      # pulled away slowly
+    fmin = 0.0
+    for _ in range(400):
+        sim.run(steps=5)
+        fy = sim.particles.numpy()["force"][0, 1]
+        fmin = min(fmin, fy)
+        if fmin < 0 and fy == 0.0:
+            break
+    # the largest pull equals T·A (A = 2R) to within one step's spring increment
+    assert -fmin == pytest.approx(T * 2 * r, abs=1e7 * 0.01 * 1e-5 * 5 + 1e-9)
+    assert sim.particles.numpy()["force"][0, 1] == 0.0
+    assert int(sim._cont.a["sbroken"].to_numpy().max()) == 1
+    # pushed back onto the edge, the broken contact carries no tension any more
+    sim.fix_particles(disc.ids, vx=0.0, vy=-0.01)
+    sim.run(steps=2000)
+    sim.fix_particles(disc.ids, vx=0.0, vy=0.01)
+    sim.run(steps=20)
+    assert sim.particles.numpy()["force"][0, 1] >= 0.0
+
+
+def test_particle_block_collision_conserves_momentum():
+    v, t = tdem.mesh.rectangle(0.4, 0.2, 8, 4, pattern="cross")
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.2)
+    block = sim.add_block(v, t, material=tdem.Elastic(1000.0, 1e7, 0.3))
+    r = 0.03
+    discs = sim.add_particles([[0.1, 0.3], [0.3, 0.26], [-0.1, 0.1]], r, density=1500.0,
+                              contact=tdem.LinearContact(kn=1e6),
+                              velocity=[[0.0, -2.0], [0.5, -1.5], [2.0, 0.3]])
+    sim.couple(discs, block, tdem.PointEdge(kn=1e6, ks=1e6, friction_angle=25.0))
+
+    def momentum():
+        p = sim.particles.numpy(stress=False)
+        nd = block.nodes()
+        mv = np.concatenate([p["mass"][:, None] * p["velocity"],
+                             nd["mass"][:, None] * nd["velocity"]])
+        return mv.sum(axis=0), np.abs(mv).sum()
+
+    p0, scale = momentum()
+    sim.run(until=0.12)
+    p1, _ = momentum()
+    assert np.abs(p1 - p0).max() < 1e-10 * scale
+    # the discs met the block: the block moves
+    assert np.abs(block.nodes()["velocity"]).max() > 0.05
+
+
+def test_couple_inputs():
+    sim = tdem.Simulation()
+    v, t = tdem.mesh.rectangle(1.0, 1.0, 2, 2)
+    b = sim.add_block(v, t, material=tdem.Elastic())
+    g = sim.add_particles([[0.5, 1.1]], 0.1, contact=tdem.LinearContact(kn=1e6))
+    with pytest.raises(ValueError, match="law"):
+        sim.couple(g, b, "spring")
+    with pytest.raises(ValueError, match="friction_angle"):
+        tdem.PointEdge(friction_angle=95)
+    with pytest.raises(ValueError, match="a must be particles"):
+        sim.couple([7], b, tdem.PointEdge())
+
+
+def test_checkpoint_with_point_edge_contacts_restarts_exactly(tmp_path):
+    sim, block, tang, _ = _disc_on(30.0, 20.0)
+    sim.run(steps=300)
+    sim.save(tmp_path / "c.h5")
+    sim.run(steps=300)
+    other = tdem.Simulation.load(tmp_path / "c.h5")
+    other.run(steps=300)
+    assert np.array_equal(sim.particles.numpy()["position"], other.particles.numpy()["position"])
+    assert np.array_equal(block.nodes()["force"], other.blocks[0].nodes()["force"])
