@@ -1,5 +1,7 @@
 """Point–edge contacts between particles and block boundary edges (Feng et al. §2.6,
-Eqs. 17–24, as decided in the physics notes §5).
+Eqs. 17–24, as decided in the physics notes §5), and vertex–edge contacts between
+blocks (§4: the boundary vertices of one block against the boundary edges of the
+other, the same law).
 
 Geometry: the boundary edge i→j of a block (counter-clockwise mesh, the block to
 its left) has the unit tangent t = (x_j − x_i)/|x_j − x_i| and the outward normal
@@ -20,8 +22,16 @@ Law (incremental springs in the edge frame, compression-positive F_n):
     momentum is conserved exactly. The force acts at the particle centre (no
     moment), as in the paper.
 
+A block vertex (no radius) touches one edge of the other block: of the edges it
+has crossed, the one it has crossed least (so that a vertex sliding under a
+block's corner meets its bottom, not its side), by less than
+``VERTEX_DEPTH`` × A (−0.05·A < d < 0; deeper, it is taken as a vertex inside the
+block, not at this edge), A its tributary length (half its two boundary edges),
+which is also its contact area.
+
 A new contact starts with F_n = F_s = 0 (the springs are incremental); a contact
-whose particle leaves the edge is forgotten. Each coupled particle keeps up to
+that slides over a node onto the adjacent edge keeps its force (turned into the
+new edge's frame); a contact whose point leaves the edges is forgotten. Each coupled particle keeps up to
 ``SLOTS`` contacts (edge index, F_n, F_s, broken flag) carried from step to step.
 """
 import math
@@ -31,6 +41,7 @@ import taichi as ti
 from physics.validate import in_range, non_negative, positive
 
 SLOTS = 4
+VERTEX_DEPTH = 0.05   # deepest vertex–edge penetration taken as a contact, × A
 # columns of the law table (one row per couple)
 L_KN, L_KS, L_TAN, L_C, L_T = 0, 1, 2, 3, 4
 LAW_WIDTH = 5
@@ -73,22 +84,27 @@ class PointEdge:
 
 
 @ti.kernel
-def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarray(),
+def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.ndarray(),
                npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                cpart: ti.types.ndarray(), ccpl: ti.types.ndarray(),
                crange: ti.types.ndarray(), edges: ti.types.ndarray(),
                claw: ti.types.ndarray(), sedge: ti.types.ndarray(),
                sforce: ti.types.ndarray(), sbroken: ti.types.ndarray(),
                xforce: ti.types.ndarray(), nforce: ti.types.ndarray(), dt: ti.f64):
-    """Contacts of every coupled particle row q (particle cpart[q] with the edges
-    crange[ccpl[q]] of its block): forces added to ``xforce`` (particles) and
-    ``nforce`` (nodes). Slots: sedge (edge or −1), sforce (F_n, F_s), sbroken."""
+    """Contacts of every coupled row q (point cpart[q] of ``pos``/``vel`` with the
+    edges crange[ccpl[q]] of a block): forces added to ``xforce`` (the points) and
+    ``nforce`` (the edges' nodes). Slots: sedge (edge or −1), sforce (F_n, F_s),
+    sbroken.
+
+    crad[q] > 0: a particle of that radius (contact while |d| < R, A = 2R);
+    crad[q] = −A < 0: a block vertex of tributary length A (vertex–edge contact
+    while it has crossed the edge, −0.05·A < d < 0)."""
     for q in range(cpart.shape[0]):
         p = cpart[q]
         c = ccpl[q]
         x = pos[p]
         v = vel[p]
-        R = prop[p][0]
+        R = crad[q]
         kn = claw[c, L_KN]
         ks = claw[c, L_KS]
         tanf = claw[c, L_TAN]
@@ -98,6 +114,21 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.
         old_b = ti.Vector([sbroken[q, k] for k in ti.static(range(SLOTS))])
         cnt = 0
         ftot = ti.Vector([0.0, 0.0])
+        best = -1
+        if R < 0.0:
+            # a vertex meets one edge of a block: the one it has crossed least
+            dbest = 1e300
+            for e in range(crange[c, 0], crange[c, 1]):
+                xi = npos[edges[e, 0]]
+                ev = npos[edges[e, 1]] - xi
+                L = ev.norm()
+                t = ev / L
+                r = x - xi
+                s = r.dot(t) / L
+                d = r.dot(ti.Vector([t[1], -t[0]]))
+                if s >= 0.0 and s < 1.0 and d < 0.0 and d > VERTEX_DEPTH * R and -d < dbest:
+                    dbest = -d
+                    best = e
         for e in range(crange[c, 0], crange[c, 1]):
             a = edges[e, 0]
             b = edges[e, 1]
@@ -110,21 +141,45 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.
             r = x - xi
             s = r.dot(t) / L
             d = r.dot(n)
-            if s >= 0.0 and s < 1.0 and ti.abs(d) < R and cnt < SLOTS:
+            touch = False
+            if R > 0.0:
+                touch = ti.abs(d) < R
+            else:
+                touch = e == best
+            if s >= 0.0 and s < 1.0 and touch and cnt < SLOTS:
                 fn = 0.0
                 fs = 0.0
                 broken = 0
+                found = False
                 for k in ti.static(range(SLOTS)):
                     if old_e[k] == e:
                         fn = old_f[k, 0]
                         fs = old_f[k, 1]
                         broken = old_b[k]
+                        found = True
+                if not found:
+                    # a contact sliding over a node onto the next edge keeps its
+                    # force, turned into the new edge's frame
+                    for k in ti.static(range(SLOTS)):
+                        o = old_e[k]
+                        if not found and o >= 0:
+                            if edges[o, 1] == a or edges[o, 0] == b:
+                                to = npos[edges[o, 1]] - npos[edges[o, 0]]
+                                to = to / to.norm()
+                                no = ti.Vector([to[1], -to[0]])
+                                fo = old_f[k, 0] * no + old_f[k, 1] * to
+                                fn = fo.dot(n)
+                                fs = fo.dot(t)
+                                broken = old_b[k]
+                                found = True
                 wi = 1.0 - s
                 wj = s
                 dd = (v - (wi * nvel[a] + wj * nvel[b])) * dt
                 fn -= kn * dd.dot(n)
                 fs -= ks * dd.dot(t)
                 area = 2.0 * R
+                if R < 0.0:
+                    area = -R
                 coh = claw[c, L_C]
                 ten = claw[c, L_T]
                 if broken != 0:

@@ -70,8 +70,9 @@ def _config(sim):
         "built": bool(sim._built),
         "slots": [{"material": m.to_dict(), "tolerance": t} for m, t in sim._slots],
         "continuum_capacity": int(sim._cont.capacity) if sim._cont is not None else 0,
-        "couples": [{"ids": [int(i) for i in ids], "block": int(b.index), "law": law.to_dict()}
-                    for ids, b, law in sim._couples],
+        "couples": [{"ids": None if ids is None else [int(i) for i in ids],
+                     "a": None if a is None else int(a.index), "block": int(b.index),
+                     "law": law.to_dict()} for ids, a, b, law in sim._couples],
     }
 
 
@@ -149,8 +150,8 @@ def save(sim, path):
 
 # the continuum's state (the rest is set up again from the host description)
 _CONTINUUM_STATE = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags", "npos",
-                    "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags", "sedge",
-                    "sforce", "sbroken")
+                    "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
+                    "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken")
 
 
 def load(path, arch=None):
@@ -219,8 +220,10 @@ def load(path, arch=None):
         b._fixes = bfix
         sim._blocks.append(b)
     from coupling.point_edge import PointEdge
-    sim._couples = [(np.asarray(c["ids"], np.int64), sim._blocks[c["block"]],
-                     PointEdge(**c["law"])) for c in cfg.get("couples", [])]
+    sim._couples = [(None if c["ids"] is None else np.asarray(c["ids"], np.int64),
+                     None if c.get("a") is None else sim._blocks[c["a"]],
+                     sim._blocks[c["block"]], PointEdge(**c["law"]))
+                    for c in cfg.get("couples", [])]
     for gd, rho in zip(cfg["groups"], sim._host["density"]):
         ids = np.arange(gd["first"], gd["first"] + gd["count"])
         sim._groups.append(ParticleGroup(sim, ids, sim._laws[gd["law"]], rho))

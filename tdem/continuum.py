@@ -35,7 +35,7 @@ MAX_CANDIDATES = 1024
 # arrays copied into the run segment's snapshot (the dynamic state)
 _SNAP = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags",
          "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
-         "sedge", "sforce", "sbroken")
+         "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken")
 
 
 @ti.kernel
@@ -225,36 +225,66 @@ class Continuum:
         self.apply_node_fixes(0.0, initial=True)
 
     def _setup_couples(self, couples):
-        """Point–edge couples: rows (particle, couple), the blocks' boundary edges,
-        one law row per couple (stiffnesses resolved by the simulation)."""
+        """Point–edge couples: rows (point, couple) with the blocks' boundary edges,
+        one law row per couple (stiffnesses resolved by the simulation). Particle
+        rows ("p" arrays) and block-vertex rows ("v" arrays: both ways for a pair of
+        blocks) are kept apart: their points live in different arrays."""
+        self.nq = {"p": 0, "v": 0}
+        rows = {"p": ([], [], [], [], [], []), "v": ([], [], [], [], [], [])}
+        for ids, a, block, law, kn, ks in couples:
+            if a is None:           # particles ids against block
+                pairs = [("p", np.asarray(ids, np.int64), None, block)]
+            else:                   # vertices of a against edges of block, and back
+                pairs = [("v", None, a, block), ("v", None, block, a)]
+            for kind, pid, src, dst in pairs:
+                parts, cpl, ranges, edges, laws, rad = rows[kind]
+                k = len(laws)
+                be = _boundary_edges(dst.triangles) + dst._offset
+                e0 = sum(len(x) for x in edges)
+                if kind == "p":
+                    pts = pid
+                    r = self._radius_of(pid)
+                else:
+                    sb = _boundary_edges(src.triangles)
+                    vs = np.unique(sb)
+                    ln = np.linalg.norm(src.vertices[sb[:, 1]] - src.vertices[sb[:, 0]], axis=1)
+                    trib = np.zeros(len(src.vertices))
+                    np.add.at(trib, sb[:, 0], 0.5 * ln)
+                    np.add.at(trib, sb[:, 1], 0.5 * ln)
+                    pts = vs + src._offset
+                    r = -trib[vs]
+                parts.append(np.asarray(pts, np.int32))
+                cpl.append(np.full(len(pts), k, np.int32))
+                ranges.append((e0, e0 + len(be)))
+                edges.append(be)
+                laws.append(law.row(kn, ks))
+                rad.append(np.asarray(r, float))
         a = self.a
-        parts, cpl, ranges, edges, laws = [], [], [], [], []
-        e0 = 0
-        for k, (ids, block, law, kn, ks) in enumerate(couples):
-            be = _boundary_edges(block.triangles) + block._offset
-            parts.append(np.asarray(ids, np.int32))
-            cpl.append(np.full(len(ids), k, np.int32))
-            ranges.append((e0, e0 + len(be)))
-            edges.append(be)
-            e0 += len(be)
-            laws.append(law.row(kn, ks))
-        self.nq = int(sum(len(p) for p in parts))
-        q = max(self.nq, 1)
-        a["cpart"] = ti.ndarray(ti.i32, (q,))
-        a["ccpl"] = ti.ndarray(ti.i32, (q,))
-        a["crange"] = ti.ndarray(ti.i32, (max(len(ranges), 1), 2))
-        a["cedges"] = ti.ndarray(ti.i32, (max(e0, 1), 2))
-        a["claw"] = ti.ndarray(ti.f64, (max(len(laws), 1), pe.LAW_WIDTH))
-        a["sedge"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
-        a["sforce"] = _arr(2, (q, pe.SLOTS))
-        a["sbroken"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
-        a["sedge"].from_numpy(-np.ones((q, pe.SLOTS), np.int32))
-        if self.nq:
-            a["cpart"].from_numpy(np.concatenate(parts))
-            a["ccpl"].from_numpy(np.concatenate(cpl))
-            a["crange"].from_numpy(np.array(ranges, np.int32))
-            a["cedges"].from_numpy(np.concatenate(edges).astype(np.int32))
-            a["claw"].from_numpy(np.array(laws, float))
+        for kind, (parts, cpl, ranges, edges, laws, rad) in rows.items():
+            n = int(sum(len(p) for p in parts))
+            self.nq[kind] = n
+            q = max(n, 1)
+            ne = max(sum(len(e) for e in edges), 1)
+            a[kind + "part"] = ti.ndarray(ti.i32, (q,))
+            a[kind + "cpl"] = ti.ndarray(ti.i32, (q,))
+            a[kind + "rad"] = ti.ndarray(ti.f64, (q,))
+            a[kind + "range"] = ti.ndarray(ti.i32, (max(len(ranges), 1), 2))
+            a[kind + "edges"] = ti.ndarray(ti.i32, (ne, 2))
+            a[kind + "law"] = ti.ndarray(ti.f64, (max(len(laws), 1), pe.LAW_WIDTH))
+            a[kind + "sedge"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
+            a[kind + "sforce"] = _arr(2, (q, pe.SLOTS))
+            a[kind + "sbroken"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
+            a[kind + "sedge"].from_numpy(-np.ones((q, pe.SLOTS), np.int32))
+            if n:
+                a[kind + "part"].from_numpy(np.concatenate(parts))
+                a[kind + "cpl"].from_numpy(np.concatenate(cpl))
+                a[kind + "rad"].from_numpy(np.concatenate(rad))
+                a[kind + "range"].from_numpy(np.array(ranges, np.int32))
+                a[kind + "edges"].from_numpy(np.concatenate(edges).astype(np.int32))
+                a[kind + "law"].from_numpy(np.array(laws, float))
+
+    def _radius_of(self, ids):
+        return self.a["rad"].to_numpy()[ids] if self.n else np.zeros(len(ids))
 
     def upload_materials(self):
         rows = np.zeros((max(len(self.slots), 1), MAT_WIDTH))
@@ -319,17 +349,21 @@ class Continuum:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
                        float(dt), serial)
-        if self.nq:
+        if self.nq["p"]:
             if not self.has_pcmm:
                 a["xforce"].fill(0.0)
-            pe.point_edge(e["pos"], e["vel"], e["prop"], a["npos"], a["nvel"], a["cpart"],
-                          a["ccpl"], a["crange"], a["cedges"], a["claw"], a["sedge"],
-                          a["sforce"], a["sbroken"], a["xforce"], a["nforce"], float(dt))
+            pe.point_edge(e["pos"], e["vel"], a["prad"], a["npos"], a["nvel"], a["ppart"],
+                          a["pcpl"], a["prange"], a["pedges"], a["plaw"], a["psedge"],
+                          a["psforce"], a["psbroken"], a["xforce"], a["nforce"], float(dt))
+        if self.nq["v"]:
+            pe.point_edge(a["npos"], a["nvel"], a["vrad"], a["npos"], a["nvel"], a["vpart"],
+                          a["vcpl"], a["vrange"], a["vedges"], a["vlaw"], a["vsedge"],
+                          a["vsforce"], a["vsbroken"], a["nforce"], a["nforce"], float(dt))
 
     @property
     def adds_forces(self):
         """Whether the particles get forces from here (elements or point–edge contacts)."""
-        return self.has_pcmm or self.nq > 0
+        return self.has_pcmm or self.nq["p"] > 0
 
     def _fix_fn_nodes(self):
         return self.nv and getattr(self, "_fix_fn", False)

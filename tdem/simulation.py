@@ -500,15 +500,21 @@ class Simulation:
     def couple(self, a, b, law):
         """Point–edge contacts (``tdem.PointEdge``) between the particles ``a`` (a
         :class:`ParticleGroup` or particle indices) and the boundary edges of the
-        block ``b`` (Feng et al. §2.6). Must be called before the first run."""
+        block ``b`` (Feng et al. §2.6); or, with ``a`` a block, vertex–edge contacts
+        both ways between the two blocks' boundaries. Must be called before the
+        first run."""
         from coupling.point_edge import PointEdge
         if not isinstance(law, PointEdge):
             raise InputError(f"law must be a tdem.PointEdge(...), got {law!r}")
         if not isinstance(b, Block) or b._sim is not self:
             raise InputError(f"b must be a block of this simulation (from add_block), got {b!r}")
         if isinstance(a, Block):
-            raise InputError("a: block–block contacts are not available in this version; "
-                             "couple particles with a block")
+            if a._sim is not self or a is b:
+                raise InputError(f"a must be another block of this simulation, got {a!r}")
+            if self._built:
+                raise InputError("a: couples must be set up before the first run")
+            self._couples.append((None, a, b, law))
+            return
         ids = a.ids if isinstance(a, ParticleGroup) else np.atleast_1d(np.asarray(a))
         ids = np.asarray(ids, dtype=np.int64)
         if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
@@ -516,16 +522,18 @@ class Simulation:
                              f"[0, {self._n})), got {ids.tolist()[:8]}")
         if self._built:
             raise InputError("a: couples must be set up before the first run")
-        self._couples.append((ids, b, law))
+        self._couples.append((ids, None, b, law))
 
     def _couple_rows(self):
         """Couples with their stiffnesses resolved (PointEdge docstring)."""
         rows = []
         laws = np.concatenate(self._host["law"]) if self._n else np.zeros(0, int)
         mats = np.concatenate(self._host["mat"]) if self._n else np.zeros(0, int)
-        for ids, b, law in self._couples:
-            cands = [(b.material.young if hasattr(b.material, "young") else 3 * b.material.bulk,
-                      getattr(b.material, "poisson", 0.5))]
+        for ids, a, b, law in self._couples:
+            cands = [(getattr(m, "young", 3 * m.bulk), getattr(m, "poisson", 0.5))
+                     for m in ([b.material] + ([a.material] if a is not None else []))]
+            if ids is None:
+                ids = np.zeros(0, np.int64)
             for slot in np.unique(mats[ids]):
                 if slot >= 0:
                     m = self._slots[slot][0]
@@ -537,7 +545,7 @@ class Simulation:
             e, nu = max(cands)
             kn = law.kn if law.kn is not None else e
             ks = law.ks if law.ks is not None else kn / (2.0 * (1.0 + nu))
-            rows.append((ids, b, law, kn, ks))
+            rows.append((ids, a, b, law, kn, ks))
         return rows
 
     def particles_in(self, xmin=-np.inf, xmax=np.inf, ymin=-np.inf, ymax=np.inf):
@@ -679,10 +687,12 @@ class Simulation:
         if self._slots:
             self._require_built()
         crit = self._cont.critical_dt() if self._cont is not None else np.inf
-        for ids, b, law, kn, ks in (self._couple_rows() if self._couples else []):
-            nm = self._cont.a["nmass"].to_numpy()[b._offset:b._offset + len(b)]
-            m = min(float(nm.min()), float(self._a["prop"].to_numpy()[ids, 1].min())
-                    if self._n else np.inf)
+        for ids, a, b, law, kn, ks in (self._couple_rows() if self._couples else []):
+            nmass = self._cont.a["nmass"].to_numpy()
+            m = min(float(nmass[o._offset:o._offset + len(o)].min())
+                    for o in ([b] if a is None else [a, b]))
+            if len(ids):
+                m = min(m, float(self._a["prop"].to_numpy()[ids, 1].min()))
             crit = min(crit, 2.0 * math.sqrt(m / max(kn, ks)))
         if self._n == 0:
             if self._blocks:
