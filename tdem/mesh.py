@@ -131,6 +131,8 @@ def polygon(points, size):
     tri = tri[path.contains_points(cent)]
     sa = signed_areas(x, tri)
     tri[sa < 0] = tri[sa < 0][:, ::-1]
+    # Qhull may close collinear side nodes with zero-area triangles: drop them
+    tri = tri[np.abs(sa) > 1e-9 * h * h]
     used = np.unique(tri)
     remap = -np.ones(len(x), np.int64)
     remap[used] = np.arange(len(used))
