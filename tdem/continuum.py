@@ -189,7 +189,10 @@ class Continuum:
             for k in range(3):
                 np.minimum.at(ns, b.triangles[:, k], alt)
             size.append(ns)
-            self._crit = min(self._crit, float(alt.min()) / b.material.p_wave_speed)
+            if not b.kinematic():
+                # a block whose every node has a prescribed velocity moves as told
+                # whatever its stiffness: it does not limit the step
+                self._crit = min(self._crit, float(alt.min()) / b.material.p_wave_speed)
             off += len(b.vertices)
         self.nv = off
         nv, nt = max(off, 1), max(sum(len(t) for t in tris), 1)

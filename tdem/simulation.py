@@ -128,6 +128,16 @@ class Block:
         if cont is not None:
             cont.apply_node_fixes(self._sim.time, initial=True)
 
+    def kinematic(self):
+        """Whether every node has both velocity components prescribed (the block then
+        moves as told: a driven rigid tool, for instance)."""
+        fx = np.zeros(len(self.vertices), bool)
+        fy = np.zeros(len(self.vertices), bool)
+        for ids, vx, vy in self._fixes:
+            fx[ids] |= vx is not None
+            fy[ids] |= vy is not None
+        return bool(fx.all() and fy.all())
+
     def nodes(self):
         """Node state now, a dict of numpy arrays: position, velocity, force (of the
         elements and contacts), reaction (of the prescribed velocities), mass,
