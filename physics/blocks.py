@@ -42,24 +42,25 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
     forces gathered into ``nforce`` (overwritten)."""
     ti.loop_config(serialize=serial)
     for e in range(tri.shape[0]):
-        t = tri[e]
-        xa, xb, xc = npos[t[0]], npos[t[1]], npos[t[2]]
-        va, vb, vc = nvel[t[0]], nvel[t[1]], nvel[t[2]]
-        h = 0.5 * dt
-        grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
-        de = fvm.strain_increment(grad, dt)
-        M = tmat[e]
-        sig = fvm.jaumann_rotate(tsig[e], fvm.spin_rate(grad), dt) + fvm.elastic_increment(
-            de, matp[M, 2], matp[M, 3])
-        st = tstate[e]
-        sig, eps, flag = mc_correct_state(sig, matp, M, ti.cast(st[1] > 0.0, ti.i32))
-        tsig[e] = sig
-        st[0] += eps
-        if flag > 0:
-            st[1] = 1.0
-        tstate[e] = st
-        fa, fb, fc = fvm.nodal_forces(sig + viscous_stress(matp, M, de, dt), xa, xb, xc, 1.0)
-        tfor[e] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+        if tmat[e] >= 0:            # −1: a triangle of a rigid block (no stress)
+            t = tri[e]
+            xa, xb, xc = npos[t[0]], npos[t[1]], npos[t[2]]
+            va, vb, vc = nvel[t[0]], nvel[t[1]], nvel[t[2]]
+            h = 0.5 * dt
+            grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
+            de = fvm.strain_increment(grad, dt)
+            M = tmat[e]
+            sig = fvm.jaumann_rotate(tsig[e], fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+                de, matp[M, 2], matp[M, 3])
+            st = tstate[e]
+            sig, eps, flag = mc_correct_state(sig, matp, M, ti.cast(st[1] > 0.0, ti.i32))
+            tsig[e] = sig
+            st[0] += eps
+            if flag > 0:
+                st[1] = 1.0
+            tstate[e] = st
+            fa, fb, fc = fvm.nodal_forces(sig + viscous_stress(matp, M, de, dt), xa, xb, xc, 1.0)
+            tfor[e] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
     ti.loop_config(serialize=serial)
     for v in range(nforce.shape[0]):
         f = ti.Vector([0.0, 0.0])

@@ -124,6 +124,7 @@ def save(sim, path):
         for n, b in enumerate(sim._blocks):
             g = blocks.create_group(f"{n:04d}")
             g.attrs["slot"] = b.slot
+            g.attrs["rigid"] = bool(b.rigid)
             g.create_dataset("vertices", data=b.vertices)
             g.create_dataset("triangles", data=b.triangles)
             g.create_dataset("velocity", data=b.velocity)
@@ -151,7 +152,7 @@ def save(sim, path):
 # the continuum's state (the rest is set up again from the host description)
 _CONTINUUM_STATE = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags", "npos",
                     "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
-                    "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken")
+                    "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")
 
 
 def load(path, arch=None):
@@ -190,7 +191,7 @@ def load(path, arch=None):
                 bfix.append((fg["ids"][()], *[fg[nm][()] if nm in fg else None
                                               for nm in ("vx", "vy")]))
             blocks.append((int(g.attrs["slot"]), g["vertices"][()], g["triangles"][()],
-                           g["velocity"][()], bfix))
+                           g["velocity"][()], bfix, bool(g.attrs.get("rigid", False))))
         cstate = ({k: d[()] for k, d in f["continuum"].items()} if "continuum" in f else {})
         fixes = []
         for key in sorted(f["fixes"]):
@@ -215,9 +216,10 @@ def load(path, arch=None):
                         if k in host else [])
     sim._slots = [(Material.from_dict(d["material"]), d["tolerance"])
                   for d in cfg.get("slots", [])]
-    for k, (slot, x, t, vel, bfix) in enumerate(blocks):
+    for k, (slot, x, t, vel, bfix, rigid) in enumerate(blocks):
         b = Block(sim, k, x, t, sim._slots[slot][0], slot, vel)
         b._fixes = bfix
+        b.rigid = rigid
         sim._blocks.append(b)
     from coupling.point_edge import PointEdge
     sim._couples = [(None if c["ids"] is None else np.asarray(c["ids"], np.int64),

@@ -25,17 +25,18 @@ from physics import pcmm
 from physics.materials import MAT_WIDTH
 
 from . import backend
-from .errors import CapacityError
+from .errors import CapacityError, InputError
 from .mesh import nodal_masses
 from .neighbors import F_BUILDS
 from .step import FIX_VX, FIX_VY, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY
 
 MAX_CANDIDATES = 1024
+RIGID_NODE = 8          # node flag: the node belongs to a free rigid block
 
 # arrays copied into the run segment's snapshot (the dynamic state)
 _SNAP = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags",
          "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
-         "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken")
+         "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")
 
 
 @ti.kernel
@@ -59,28 +60,82 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
         nflags[0] = nv
     ti.loop_config(serialize=serial)
     for v in range(nv):
-        m = nmass[v]
-        v0 = nvel[v]
-        f = nforce[v] + m * g
-        fd = -alpha_l * ti.abs(f) * ti.math.sign(v0)
-        den = 1.0 + 0.5 * alpha * dt
-        v1 = (v0 * (1.0 - 0.5 * alpha * dt) + (f + fd) / m * dt) / den
-        vfree = v1
-        fx = nfix[v]
-        if fx & 1:
-            v1[0] = nvfix[v][0]
-        if fx & 2:
-            v1[1] = nvfix[v][1]
-        nreact[v] = m * (v1 - vfree) / dt
-        x1 = npos[v] + v1 * dt
-        nvel[v] = v1
-        npos[v] = x1
-        s = x1[0] + x1[1] + v1[0] + v1[1]
-        bad = not (s == s) or ti.abs(s) > 1e300
-        if not bad:
-            bad = v1.norm() * dt > 0.5 * nsize[v]
-        if bad:
-            ti.atomic_min(nflags[0], v)
+        if (nfix[v] & RIGID_NODE) == 0:   # nodes of rigid blocks move with their body
+            m = nmass[v]
+            v0 = nvel[v]
+            f = nforce[v] + m * g
+            fd = -alpha_l * ti.abs(f) * ti.math.sign(v0)
+            den = 1.0 + 0.5 * alpha * dt
+            v1 = (v0 * (1.0 - 0.5 * alpha * dt) + (f + fd) / m * dt) / den
+            vfree = v1
+            fx = nfix[v]
+            if fx & 1:
+                v1[0] = nvfix[v][0]
+            if fx & 2:
+                v1[1] = nvfix[v][1]
+            nreact[v] = m * (v1 - vfree) / dt
+            x1 = npos[v] + v1 * dt
+            nvel[v] = v1
+            npos[v] = x1
+            s = x1[0] + x1[1] + v1[0] + v1[1]
+            bad = not (s == s) or ti.abs(s) > 1e300
+            if not bad:
+                bad = v1.norm() * dt > 0.5 * nsize[v]
+            if bad:
+                ti.atomic_min(nflags[0], v)
+
+
+@ti.kernel
+def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
+                    nforce: ti.types.ndarray(), nmass: ti.types.ndarray(),
+                    rbody: ti.types.ndarray(), rstate: ti.types.ndarray(),
+                    rref: ti.types.ndarray(), simp: ti.types.ndarray()):
+    """Rigid blocks: force and moment of their nodes' forces about the centre, plus
+    gravity; local and global damping as for particles; leapfrog for the centre and
+    the angle; the nodes are then placed rigidly, x = c + R(θ)·r₀, and given the
+    rigid-body velocity v + ω × (x − c)."""
+    dt = simp[P_DT]
+    g = ti.Vector([simp[P_GX], simp[P_GY]])
+    alpha = simp[P_ALPHA]
+    alpha_l = simp[P_ALPHA_LOCAL]
+    ti.loop_config(serialize=True)
+    for r in range(rbody.shape[0]):
+        o = ti.cast(rbody[r, 0], ti.i32)
+        k = ti.cast(rbody[r, 1], ti.i32)
+        m = rbody[r, 2]
+        inertia = rbody[r, 3]
+        if k > 0:
+            c = ti.Vector([rstate[r, 0], rstate[r, 1]])
+            v0 = ti.Vector([rstate[r, 2], rstate[r, 3]])
+            w0 = rstate[r, 5]
+            f = m * g
+            mom = 0.0
+            for q in range(o, o + k):
+                fq = nforce[q]
+                d = npos[q] - c
+                f += fq
+                mom += d[0] * fq[1] - d[1] * fq[0]
+            fd = -alpha_l * ti.abs(f) * ti.math.sign(v0)
+            md = -alpha_l * ti.abs(mom) * ti.math.sign(w0)
+            den = 1.0 + 0.5 * alpha * dt
+            num = 1.0 - 0.5 * alpha * dt
+            v1 = (v0 * num + (f + fd) / m * dt) / den
+            w1 = (w0 * num + (mom + md) / inertia * dt) / den
+            c1 = c + v1 * dt
+            th = rstate[r, 4] + w1 * dt
+            cs = ti.cos(th)
+            sn = ti.sin(th)
+            for q in range(o, o + k):
+                r0 = rref[q]
+                d = ti.Vector([cs * r0[0] - sn * r0[1], sn * r0[0] + cs * r0[1]])
+                npos[q] = c1 + d
+                nvel[q] = v1 + w1 * ti.Vector([-d[1], d[0]])
+            rstate[r, 0] = c1[0]
+            rstate[r, 1] = c1[1]
+            rstate[r, 2] = v1[0]
+            rstate[r, 3] = v1[1]
+            rstate[r, 4] = th
+            rstate[r, 5] = w1
 
 
 def _arr(spec, shape, dtype=ti.f64):
@@ -182,14 +237,15 @@ class Continuum:
             b._offset = off
             verts.append(b.vertices)
             tris.append(b.triangles + off)
-            tmat.append(np.full(len(b.triangles), b.slot, np.int32))
+            # rigid blocks carry no stress: their triangles are skipped (material −1)
+            tmat.append(np.full(len(b.triangles), -1 if b.rigid else b.slot, np.int32))
             mass.append(nodal_masses(b.vertices, b.triangles, b.material.density))
             alt = blk.altitudes(b.vertices, b.triangles)
             ns = np.full(len(b.vertices), np.inf)
             for k in range(3):
                 np.minimum.at(ns, b.triangles[:, k], alt)
             size.append(ns)
-            if not b.kinematic():
+            if not b.kinematic() and not b.rigid:
                 # a block whose every node has a prescribed velocity moves as told
                 # whatever its stiffness: it does not limit the step
                 self._crit = min(self._crit, float(alt.min()) / b.material.p_wave_speed)
@@ -220,6 +276,7 @@ class Continuum:
         a["nsize"].from_numpy(np.concatenate(size))
         a["tri"].from_numpy(t.astype(np.int32))
         a["tmat"].from_numpy(np.concatenate(tmat))
+        self._setup_rigid(np.concatenate(mass))
         start, inc = blk.incidence(t, off)
         a["inc_start"] = ti.ndarray(ti.i32, (len(start),))
         a["inc_start"].from_numpy(start)
@@ -289,6 +346,41 @@ class Continuum:
     def _radius_of(self, ids):
         return self.a["rad"].to_numpy()[ids] if self.n else np.zeros(len(ids))
 
+    def _setup_rigid(self, mass):
+        """Rigid blocks: rows (first node, node count, mass, inertia about the centre)
+        and state (centre, velocity, angle, angular velocity); their nodes are
+        flagged so that the node integrator leaves them to :func:`integrate_rigid`."""
+        a = self.a
+        rows, state = [], []
+        for b in self.blocks:
+            if not b.rigid:
+                continue
+            if b._fixes and not b.kinematic():
+                raise InputError(f"a rigid block moves as one body: fix all its nodes (a "
+                                 f"driven block) or none; block {b.index} has some fixed")
+            if b.kinematic():
+                continue
+            m = mass[b._offset:b._offset + len(b.vertices)]
+            mt = float(m.sum())
+            cen = (m @ b.vertices) / mt
+            inertia = float(m @ np.sum((b.vertices - cen) ** 2, axis=1))
+            v0 = b.velocity.mean(axis=0)
+            rows.append([b._offset, len(b.vertices), mt, inertia])
+            state.append([cen[0], cen[1], v0[0], v0[1], 0.0, 0.0])
+        self.nrigid = len(rows)
+        a["rbody"] = ti.ndarray(ti.f64, (max(len(rows), 1), 4))
+        a["rstate"] = ti.ndarray(ti.f64, (max(len(rows), 1), 6))
+        a["rref"] = _arr(2, (max(self.nv, 1),))
+        if rows:
+            a["rbody"].from_numpy(np.array(rows, float))
+            a["rstate"].from_numpy(np.array(state, float))
+            ref = np.zeros((self.nv, 2))
+            for r, s in zip(rows, state):
+                o, k = int(r[0]), int(r[1])
+                x = np.concatenate([bb.vertices for bb in self.blocks])[o:o + k]
+                ref[o:o + k] = x - np.array(s[:2])
+            a["rref"].from_numpy(ref)
+
     def upload_materials(self):
         rows = np.zeros((max(len(self.slots), 1), MAT_WIDTH))
         tol = np.zeros(max(len(self.slots), 1))
@@ -320,6 +412,9 @@ class Continuum:
                     elif initial:
                         self._nvfix[g, col] = v
         if initial:
+            for b in self.blocks:
+                if b.rigid and not b.kinematic():
+                    self._nfix[b._offset:b._offset + len(b.vertices)] |= RIGID_NODE
             self.a["nfix"].from_numpy(self._nfix)
             self._fix_fn = any_fn
         self.a["nvfix"].from_numpy(self._nvfix)
@@ -374,6 +469,9 @@ class Continuum:
     def after_step(self, sim):
         if self.nv:
             a = self.a
+            if self.nrigid:
+                integrate_rigid(a["npos"], a["nvel"], a["nforce"], a["nmass"], a["rbody"],
+                                a["rstate"], a["rref"], sim._a["simp"])
             integrate_nodes(a["npos"], a["nvel"], a["nmass"], a["nforce"], a["nfix"],
                             a["nvfix"], a["nsize"], a["nreact"], sim._a["simp"], a["nflags"],
                             backend.serial_loops())

@@ -105,6 +105,7 @@ class Block:
         self.velocity = velocity
         self._fixes = []
         self._offset = 0
+        self.rigid = False
 
     def __len__(self):
         return len(self.vertices)
@@ -478,12 +479,13 @@ class Simulation:
         return len(self._slots) - 1
 
     def add_block(self, vertices, triangles, material, rigid=False, velocity=(0.0, 0.0)):
-        """Add a deformable block: a triangle mesh (vertices (V, 2), counter-clockwise
-        triangles (T, 3)) of a continuum material, with lumped nodal masses.
+        """Add a block: a triangle mesh (vertices (V, 2), counter-clockwise triangles
+        (T, 3)) of a continuum material, with lumped nodal masses. ``rigid=True``: a
+        rigid body (3 degrees of freedom: its mass, centre and moment of inertia from
+        the lumped masses; no stress), free, or driven by fixing all its nodes.
         ``velocity``: initial velocity of every node. Returns a :class:`Block`."""
-        if rigid:
-            raise InputError("rigid: rigid blocks are not available in this version; "
-                             "got rigid=True (use a stiff deformable block)")
+        if rigid not in (True, False):
+            raise InputError(f"rigid must be True or False, got {rigid!r}")
         if not isinstance(material, Material):
             raise InputError("material must be a continuum material such as "
                              f"tdem.Elastic(...), got {material!r}")
@@ -500,6 +502,7 @@ class Simulation:
         self._slots.append((material, None))
         b = Block(self, len(self._blocks), x, t, material, slot,
                   np.broadcast_to(v, x.shape).copy())
+        b.rigid = bool(rigid)
         self._blocks.append(b)
         return b
 

@@ -149,7 +149,7 @@ def test_checkpoint_with_point_edge_contacts_restarts_exactly(tmp_path):
     assert np.array_equal(block.nodes()["force"], other.blocks[0].nodes()["force"])
 
 
-def _block_on_incline(angle_deg, damping=0.0):
+def _block_on_incline(angle_deg, damping=0.0, rigid=False):
     a = math.radians(angle_deg)
     rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
     vb, tb = tdem.mesh.rectangle(3.0, 0.2, 15, 1, origin=(-1.5, -0.2))
@@ -158,7 +158,7 @@ def _block_on_incline(angle_deg, damping=0.0):
     mat = tdem.Elastic(2500.0, 1e9, 0.25)
     base = sim.add_block(vb @ rot.T, tb, material=mat)
     base.fix(np.arange(len(vb)), vx=0.0, vy=0.0)
-    top = sim.add_block(vt @ rot.T, tt, material=mat)
+    top = sim.add_block(vt @ rot.T, tt, material=mat, rigid=rigid)
     sim.couple(top, base, tdem.PointEdge(friction_angle=25.0))
     return sim, top, rot @ np.array([1.0, 0.0])
 
@@ -182,8 +182,9 @@ def test_block_rests_on_a_block_inclined_below_its_friction_angle():
     assert abs(x2 - x1) < 2e-5
 
 
-def test_block_slides_on_a_block_inclined_above_its_friction_angle():
-    sim, top, tang = _block_on_incline(30.0)
+@pytest.mark.parametrize("rigid", [False, True])
+def test_block_slides_on_a_block_inclined_above_its_friction_angle(rigid):
+    sim, top, tang = _block_on_incline(30.0, rigid=rigid)
     sim.run(until=0.05)
     x0 = _centre(top, tang)
     nd = top.nodes()
@@ -197,12 +198,13 @@ def test_block_slides_on_a_block_inclined_above_its_friction_angle():
     assert acc == pytest.approx(want, rel=0.03)
 
 
-def test_block_block_collision_conserves_momentum():
+@pytest.mark.parametrize("rigid", [False, True])
+def test_block_block_collision_conserves_momentum(rigid):
     va, ta = tdem.mesh.rectangle(0.2, 0.2, 2, 2, pattern="cross")
     vb, tb = tdem.mesh.rectangle(0.2, 0.2, 2, 2, pattern="cross", origin=(0.201, 0.05))
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
     mat = tdem.Elastic(1000.0, 1e7, 0.3)
-    a = sim.add_block(va, ta, material=mat, velocity=(1.0, 0.1))
+    a = sim.add_block(va, ta, material=mat, velocity=(1.0, 0.1), rigid=rigid)
     b = sim.add_block(vb, tb, material=mat, velocity=(-0.5, 0.0))
     sim.couple(a, b, tdem.PointEdge(friction_angle=25.0))
 
@@ -217,3 +219,17 @@ def test_block_block_collision_conserves_momentum():
     assert np.abs(p1 - p0).max() < 1e-10 * scale
     # they met: b now moves right
     assert (b.nodes()["mass"] @ b.nodes()["velocity"][:, 0]) > 0.0
+
+
+def test_rigid_block_falls_freely_and_keeps_its_shape():
+    v, t = tdem.mesh.rectangle(0.3, 0.1, 3, 1)
+    sim = tdem.Simulation(gravity=(0.0, -G), dt=1e-4)
+    b = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e9, 0.25), rigid=True,
+                      velocity=(1.0, 0.0))
+    sim.run(steps=1000)
+    nd = b.nodes()
+    tt = sim.time
+    # leapfrog from rest: Σ g·k·dt² = ½ g t (t + dt)
+    assert np.allclose(nd["displacement"][:, 1], -0.5 * G * tt * (tt + 1e-4), rtol=1e-9)
+    assert np.allclose(nd["displacement"][:, 0], 1.0 * tt, rtol=1e-9)
+    assert np.allclose(nd["velocity"][:, 1], -G * tt, rtol=1e-9)
