@@ -555,6 +555,37 @@ class Continuum:
                 "plastic_strain": st[:, 0].copy(), "failed": st[:, 1] > 0.5,
                 "elements": st[:, 2].astype(np.int64), "pmat": a["pmat"].to_numpy()}
 
+    def point_edge_contacts(self, pos):
+        """Point–edge contacts now: point (C, 2) (particle centre or vertex), foot (C, 2)
+        (its projection on the edge), normal (C,) F_n compression-positive, shear (C,),
+        broken (C,) bool, kind (C,) 0 particle–block, 1 vertex–edge. ``pos``: the
+        particles' positions."""
+        a = self.a
+        npos = a["npos"].to_numpy()
+        out = {k: [] for k in ("point", "foot", "normal", "shear", "broken", "kind")}
+        for kind, src in (("p", pos), ("v", npos)):
+            if not self.nq[kind]:
+                continue
+            se = a[kind + "sedge"].to_numpy()
+            sf = a[kind + "sforce"].to_numpy()
+            sb = a[kind + "sbroken"].to_numpy()
+            part = a[kind + "part"].to_numpy()
+            edges = a[kind + "edges"].to_numpy()
+            q, k = np.nonzero(se >= 0)
+            x = src[part[q]]
+            xi, xj = npos[edges[se[q, k], 0]], npos[edges[se[q, k], 1]]
+            t = xj - xi
+            s = np.einsum("ij,ij->i", x - xi, t) / np.einsum("ij,ij->i", t, t)
+            out["point"].append(x)
+            out["foot"].append(xi + s[:, None] * t)
+            out["normal"].append(sf[q, k, 0])
+            out["shear"].append(sf[q, k, 1])
+            out["broken"].append(sb[q, k] > 0)
+            out["kind"].append(np.full(len(q), 0 if kind == "p" else 1))
+        empty = {"point": np.zeros((0, 2)), "foot": np.zeros((0, 2)), "normal": np.zeros(0),
+                 "shear": np.zeros(0), "broken": np.zeros(0, bool), "kind": np.zeros(0, int)}
+        return {k: (np.concatenate(v) if v else empty[k]) for k, v in out.items()}
+
     def block_nodes(self, b):
         a = self.a
         sl = slice(b._offset, b._offset + len(b.vertices))

@@ -172,6 +172,23 @@ def write_blocks_vtu(sim, path):
     return path
 
 
+def write_couplings_vtu(sim, path):
+    """Point–edge contacts of ``sim`` to ``path``: one ``line`` cell per contact, from
+    the particle centre (or block vertex) to its foot on the edge. Cell data:
+    ``normal_force`` (N, compression-positive), ``shear_force``, ``broken``, ``kind``
+    (0 particle–block, 1 block–block)."""
+    c = sim.point_edge_contacts()
+    n = len(c["normal"])
+    pts = np.concatenate([_xyz(c["point"]), _xyz(c["foot"])])
+    lines = np.stack([np.arange(n), np.arange(n) + n], axis=1).astype(np.int64)
+    _write_mesh(path, pts, [("line", lines)],
+                cell_data={"normal_force": [np.asarray(c["normal"], float)],
+                           "shear_force": [np.asarray(c["shear"], float)],
+                           "broken": [np.asarray(c["broken"], np.int64)],
+                           "kind": [np.asarray(c["kind"], np.int64)]})
+    return path
+
+
 def write_walls_vtu(sim, path):
     """Walls of ``sim`` to ``path``: one ``line`` cell per wall (points p0, p1).
 
@@ -249,6 +266,9 @@ def write_vtu(sim, path, walls=True, contacts=True):
                                               p)))
     if sim.blocks:
         written.append(str(write_blocks_vtu(sim, path.with_name(path.stem + "_blocks.vtu"))))
+    if getattr(sim, "_couples", None):
+        written.append(str(write_couplings_vtu(sim, path.with_name(path.stem +
+                                                                   "_couplings.vtu"))))
     if walls:
         written.append(str(write_walls_vtu(sim, path.with_name(path.stem + "_walls.vtu"))))
     if contacts:
@@ -393,6 +413,8 @@ class Output:
             names["elements"] = f"elements_{k:05d}.vtu"
         if self._sim is not None and self._sim.blocks:
             names["blocks"] = f"blocks_{k:05d}.vtu"
+        if self._sim is not None and getattr(self._sim, "_couples", None):
+            names["couplings"] = f"couplings_{k:05d}.vtu"
         if self.walls:
             names["walls"] = f"walls_{k:05d}.vtu"
         if self.contacts:
@@ -449,6 +471,8 @@ class Output:
             written.append(str(write_elements_vtu(sim, self.directory / names["elements"], p)))
         if "blocks" in names:
             written.append(str(write_blocks_vtu(sim, self.directory / names["blocks"])))
+        if "couplings" in names:
+            written.append(str(write_couplings_vtu(sim, self.directory / names["couplings"])))
         if self.walls:
             written.append(str(write_walls_vtu(sim, self.directory / names["walls"])))
         if self.contacts:

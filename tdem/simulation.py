@@ -1362,6 +1362,19 @@ class Simulation:
                     "stress_zz": np.zeros(0)}
         return self._cont.elements()
 
+    def point_edge_contacts(self):
+        """Point–edge contacts in force now (particle–block and block–block), a dict of
+        numpy arrays: point (C, 2) (particle centre or block vertex), foot (C, 2)
+        (its projection on the edge), normal (C,) compression-positive, shear (C,),
+        broken (C,) (cohesion and tension lost), kind (C,) 0 particle, 1 vertex."""
+        self._require_built()
+        pos = self._a["pos"].to_numpy() if self._n else np.zeros((0, 2))
+        if self._cont is None:
+            return {
+                "point": np.zeros((0, 2)), "foot": np.zeros((0, 2)), "normal": np.zeros(0),
+                "shear": np.zeros(0), "broken": np.zeros(0, bool), "kind": np.zeros(0, int)}
+        return self._cont.point_edge_contacts(pos)
+
     def energy(self):
         """Energy account (J per metre of thickness) at the last completed step:
         kinetic, gravitational (relative to the origin), elastic (springs),

@@ -233,3 +233,18 @@ def test_rigid_block_falls_freely_and_keeps_its_shape():
     assert np.allclose(nd["displacement"][:, 1], -0.5 * G * tt * (tt + 1e-4), rtol=1e-9)
     assert np.allclose(nd["displacement"][:, 0], 1.0 * tt, rtol=1e-9)
     assert np.allclose(nd["velocity"][:, 1], -G * tt, rtol=1e-9)
+
+
+def test_point_edge_contacts_are_written_for_paraview(tmp_path):
+    import meshio
+    sim, block, _, _ = _disc_on(0.0, 30.0, damping=0.7)
+    sim.output(tmp_path / "o", every=500)
+    sim.run(steps=1000)
+    c = sim.point_edge_contacts()
+    assert len(c["normal"]) == 1
+    m = meshio.read(tmp_path / "o" / "couplings_00002.vtu")
+    assert m.cells_dict["line"].shape == (1, 2)
+    w = sim.particles.numpy()["mass"][0] * G
+    assert m.cell_data["normal_force"][0][0] == pytest.approx(w, rel=0.05)
+    assert (tmp_path / "o" / "couplings.pvd").exists()
+    assert (tmp_path / "o" / "blocks.pvd").exists()
