@@ -146,6 +146,10 @@ def save(sim, path):
             for k, arr in sim._cont.a.items():
                 if k in _CONTINUUM_STATE:
                     cg.create_dataset(k, data=arr.to_numpy())
+            for kind in sim._cont.nr:
+                ng = f.create_group(f"nonreflecting_{kind}")
+                ng.create_dataset("ids", data=sim._cont.a[f"nr{kind}ids"].to_numpy())
+                ng.create_dataset("coef", data=sim._cont.a[f"nr{kind}coef"].to_numpy())
     return path
 
 
@@ -193,6 +197,9 @@ def load(path, arch=None):
             blocks.append((int(g.attrs["slot"]), g["vertices"][()], g["triangles"][()],
                            g["velocity"][()], bfix, bool(g.attrs.get("rigid", False))))
         cstate = ({k: d[()] for k, d in f["continuum"].items()} if "continuum" in f else {})
+        nonref = {kind: (f[f"nonreflecting_{kind}"]["ids"][()],
+                         f[f"nonreflecting_{kind}"]["coef"][()])
+                  for kind in ("p", "v") if f"nonreflecting_{kind}" in f}
         fixes = []
         for key in sorted(f["fixes"]):
             g = f["fixes"][key]
@@ -260,6 +267,8 @@ def load(path, arch=None):
             if arr is not None and tuple(arr.shape) == v.shape[:len(arr.shape)]:
                 arr.from_numpy(np.ascontiguousarray(v))
         sim._cont.apply_node_fixes(sim._time, initial=True)
+        for kind, (ids, coef) in nonref.items():
+            sim._cont.set_non_reflecting(kind, ids, coef)
     sim._last_fit = cfg["last_fit"]
     return sim
 

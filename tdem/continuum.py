@@ -86,6 +86,22 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
 
 
 @ti.kernel
+def viscous_boundary(vel: ti.types.ndarray(), force: ti.types.ndarray(),
+                     ids: ti.types.ndarray(), coef: ti.types.ndarray()):
+    """Non-reflecting (Lysmer–Kuhlemeyer) boundary: on point ids[r] with outward unit
+    normal n = coef[r, 0:2] and dashpots a_n = A·ρ·c_p, a_s = A·ρ·c_s in coef[r, 2:4],
+    the traction −a_n (v·n) n − a_s (v·t) t is added to ``force``."""
+    for r in range(ids.shape[0]):
+        i = ids[r]
+        n = ti.Vector([coef[r, 0], coef[r, 1]])
+        t = ti.Vector([-n[1], n[0]])
+        v = vel[i]
+        f = -coef[r, 2] * v.dot(n) * n - coef[r, 3] * v.dot(t) * t
+        ti.atomic_add(force[i][0], f[0])
+        ti.atomic_add(force[i][1], f[1])
+
+
+@ti.kernel
 def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                     nforce: ti.types.ndarray(), nmass: ti.types.ndarray(),
                     rbody: ti.types.ndarray(), rstate: ti.types.ndarray(),
@@ -196,6 +212,7 @@ class Continuum:
         self._alloc_lists()
         self._setup_blocks()
         self._setup_couples(couples)
+        self.nr = {}
         self.snap = {}
 
     # ------------------------------------------------------------------ set-up
@@ -266,6 +283,7 @@ class Continuum:
         if off == 0:
             a["inc_start"] = ti.ndarray(ti.i32, (2,))
             a["inc"] = ti.ndarray(ti.i32, (1,))
+            self._setup_rigid(np.zeros(0))
             return
         x = np.concatenate(verts)
         t = np.concatenate(tris)
@@ -458,10 +476,32 @@ class Continuum:
                           a["vcpl"], a["vrange"], a["vedges"], a["vlaw"], a["vsedge"],
                           a["vsforce"], a["vsbroken"], a["nforce"], a["nforce"], float(dt))
 
+        for kind, vel, force in (("p", e.get("vel"), a["xforce"]), ("v", a["nvel"], a["nforce"])):
+            nr = self.nr.get(kind, 0)
+            if nr:
+                if kind == "p" and not self.has_pcmm and not self.nq["p"]:
+                    a["xforce"].fill(0.0)
+                viscous_boundary(vel, force, a["nr" + kind + "ids"], a["nr" + kind + "coef"])
+
+    def set_non_reflecting(self, kind, ids, coef):
+        """Rows of the viscous boundary: ``kind`` "p" (particles) or "v" (block nodes)."""
+        self.nr = getattr(self, "nr", {})
+        a = self.a
+        old_ids = a[f"nr{kind}ids"].to_numpy() if self.nr.get(kind) else np.zeros(0, np.int32)
+        old_coef = a[f"nr{kind}coef"].to_numpy() if self.nr.get(kind) else np.zeros((0, 4))
+        ids = np.concatenate([old_ids, np.asarray(ids, np.int32)])
+        coef = np.concatenate([old_coef, np.asarray(coef, float)])
+        a[f"nr{kind}ids"] = ti.ndarray(ti.i32, (len(ids),))
+        a[f"nr{kind}ids"].from_numpy(ids.astype(np.int32))
+        a[f"nr{kind}coef"] = ti.ndarray(ti.f64, (len(ids), 4))
+        a[f"nr{kind}coef"].from_numpy(coef)
+        self.nr[kind] = len(ids)
+
     @property
     def adds_forces(self):
-        """Whether the particles get forces from here (elements or point–edge contacts)."""
-        return self.has_pcmm or self.nq["p"] > 0
+        """Whether the particles get forces from here (elements, point–edge contacts,
+        viscous boundaries)."""
+        return self.has_pcmm or self.nq["p"] > 0 or getattr(self, "nr", {}).get("p", 0) > 0
 
     def _fix_fn_nodes(self):
         return self.nv and getattr(self, "_fix_fn", False)

@@ -362,6 +362,7 @@ class Simulation:
         self._blocks = []
         self._cont = None          # Continuum (PCMM elements, blocks) once built
         self._couples = []         # (particle ids, block, PointEdge)
+        self._nonreflect = []      # ("p" | "v", ids, coef rows) of viscous boundaries
         self._walls_host = []      # rows of the wall table
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
@@ -536,6 +537,92 @@ class Simulation:
         if self._built:
             raise InputError("a: couples must be set up before the first run")
         self._couples.append((ids, None, b, law))
+
+    def non_reflecting(self, target, normal=None):
+        """Viscous (Lysmer–Kuhlemeyer) non-reflecting boundary on particles or block
+        nodes: the traction −ρ·c_p·v_n on the normal and −ρ·c_s·v_s on the tangential
+        velocity, over the point's tributary length (2R for a particle, half its two
+        boundary edges for a node), ρ, c_p, c_s of its material.
+
+        ``target``: particle indices (or a :class:`ParticleGroup`) of PCMM particles,
+        a :class:`Block` (all its boundary nodes) or ``(block, nodes)``. ``normal``:
+        the outward unit normal, (2,) or one per point; default: from the block's
+        boundary edges joining the given nodes (which also give the tributary
+        lengths), or for particles away from the centroid of their neighbours
+        within 3R.
+        """
+        if isinstance(target, tuple) and len(target) == 2 and isinstance(target[0], Block):
+            block, nodes = target
+        elif isinstance(target, Block):
+            block, nodes = target, None
+        else:
+            block = None
+        if block is not None:
+            be = _mesh.boundary_edges(block.triangles)
+            x = block.vertices
+            bnodes = np.unique(be)
+            nodes = bnodes if nodes is None else np.atleast_1d(np.asarray(nodes, np.int64))
+            if nodes.size == 0 or not np.isin(nodes, bnodes).all():
+                raise InputError(f"target: nodes must be boundary nodes of the block, got "
+                                 f"{np.asarray(nodes).tolist()[:8]}")
+            # the boundary covered: the edges with both ends among the nodes
+            be = be[np.isin(be[:, 0], nodes) & np.isin(be[:, 1], nodes)]
+            if len(be) == 0:
+                raise InputError("target: the nodes must span at least one boundary edge")
+            m = x[be[:, 1]] - x[be[:, 0]]
+            nrm_len = np.stack([m[:, 1], -m[:, 0]], 1)          # n·L, outward
+            acc = np.zeros_like(x)
+            trib = np.zeros(len(x))
+            for k in (0, 1):
+                np.add.at(acc, be[:, k], nrm_len)
+                np.add.at(trib, be[:, k], 0.5 * np.linalg.norm(m, axis=1))
+            n = acc[nodes] / np.linalg.norm(acc[nodes], axis=1)[:, None] if normal is None \
+                else self._unit_normals(normal, len(nodes))
+            mat = block.material
+            area = trib[nodes]
+            kind, ids = "v", nodes
+        else:
+            ids = target.ids if isinstance(target, ParticleGroup) else target
+            ids = np.atleast_1d(np.asarray(ids, np.int64))
+            if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
+                raise InputError(f"target must be particle indices in [0, {self._n}), a block "
+                                 f"or (block, nodes), got {np.asarray(ids).tolist()[:8]}")
+            slots = np.concatenate(self._host["mat"])[ids]
+            if (slots < 0).any() or len(np.unique(slots)) != 1:
+                raise InputError("target: a viscous boundary needs PCMM particles of one "
+                                 "material (add_particles(..., material=...))")
+            mat = self._slots[int(slots[0])][0]
+            pos = np.concatenate(self._host["pos"])
+            rad = np.concatenate(self._host["radius"])
+            if normal is None:
+                n = np.zeros((len(ids), 2))
+                body = np.flatnonzero(np.concatenate(self._host["mat"]) == slots[0])
+                for k, i in enumerate(ids):
+                    d = pos[body] - pos[i]
+                    near = body[np.einsum("ij,ij->i", d, d) < (3 * rad[i]) ** 2]
+                    out = pos[i] - pos[near].mean(axis=0)
+                    n[k] = out / max(np.linalg.norm(out), 1e-300)
+            else:
+                n = self._unit_normals(normal, len(ids))
+            area = 2.0 * rad[ids]
+            kind = "p"
+        rho = mat.density
+        cp = mat.p_wave_speed
+        cs = math.sqrt(mat.shear / rho)
+        coef = np.column_stack([n, area * rho * cp, area * rho * cs])
+        if kind == "v":
+            ids = ids + block._offset if self._cont is not None else ids
+        self._nonreflect.append((kind, ids, coef, block))
+        if self._cont is not None:
+            self._cont.set_non_reflecting(kind, ids, coef)
+
+    @staticmethod
+    def _unit_normals(normal, k):
+        n = np.broadcast_to(np.asarray(normal, dtype=float), (k, 2)).copy()
+        ln = np.linalg.norm(n, axis=1)
+        if not np.all(np.isfinite(n)) or (ln == 0).any():
+            raise InputError(f"normal must be non-zero vectors, got {normal!r}")
+        return n / ln[:, None]
 
     def _couple_rows(self):
         """Couples with their stiffnesses resolved (PointEdge docstring)."""
@@ -810,6 +897,9 @@ class Simulation:
                 pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
             self._cont = Continuum(pos, rad, pmat, self._slots, self._blocks,
                                    couples=self._couple_rows())
+            for kind, ids, coef, block in self._nonreflect:
+                self._cont.set_non_reflecting(
+                    kind, ids + block._offset if kind == "v" else ids, coef)
         if self._n == 0:
             # blocks only: no particle arrays, the engine's parameters only
             self._a = {"simp": ti.ndarray(ti.f64, (stepk.SIMP_SIZE,))}
