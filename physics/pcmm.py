@@ -753,7 +753,8 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
            pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), enbr: ti.types.ndarray(),
            encnt: ti.types.ndarray(), cskip: ti.types.ndarray(), inc: ti.types.ndarray(),
            icnt: ti.types.ndarray(), emult: ti.types.ndarray(), pflags: ti.types.ndarray(),
-           dt: ti.f64,
+           elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
+           ecnt_old: ti.types.ndarray(), dt: ti.f64, carry: ti.template(),
            serial: ti.template()):
     """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16), for the particles of x_n
     moving at v_{n−1/2}:
@@ -766,8 +767,13 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
        nodal forces with the weight 1/N_e (Eqs. 13–14, sign fixed);
     3. per particle (gathered, no atomics): force of its elements → xforce,
        stress = mean of its elements' σ (zero in none), strain and plastic shear
-       strain += the means of the increments; the engine's pair slots of particles
-       that share an element are marked in ``cskip`` (no DEM contact between them).
+       strain += the means of the increments; the engine's pair slots of same-body
+       Eq. 1 neighbours of which at least one is in an element are marked in
+       ``cskip``: no DEM contact between them, the elements carry their
+       interaction (a pair that touches but was left out of the elements by the
+       angular pruning would otherwise push apart by its initial overlap at the
+       contact law's stiffness). Particles of different bodies, and particles in
+       no element, meet through the contact law.
 
     pstate[i] = (plastic shear strain, failed (0/1), elements containing i, −).
     """
@@ -789,6 +795,14 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                     nbr[i, cnt] = j
                     cnt += 1
             ncnt[i] = cnt
+            if ti.static(carry):
+                # keep last step's elements of i and their stresses (every copy holds its
+                # triangle's stress, see 2b)
+                ecnt_old[i] = ecnt[i]
+                for s in range(ecnt[i]):
+                    elem_old[i, s, 0] = elem[i, s, 0]
+                    elem_old[i, s, 1] = elem[i, s, 1]
+                    esig_old[i, s] = esig[i, s]
             r = _ring(i, xi, cnt, pos, nbr, ring, rang)
             ecnt[i] = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
         else:
@@ -851,6 +865,20 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 de = fvm.strain_increment(grad, dt)
                 M = pmat[a]
                 sig = (psig[a] + psig[b] + psig[c]) / 3.0
+                if ti.static(carry):
+                    # an element that existed last step continues from its own stress
+                    found = False
+                    for t in ti.static(range(3)):
+                        o, u, w = a, b, c
+                        if ti.static(t == 1):
+                            o, u, w = b, c, a
+                        if ti.static(t == 2):
+                            o, u, w = c, a, b
+                        if not found:
+                            for so in range(ecnt_old[o]):
+                                if elem_old[o, so, 0] == u and elem_old[o, so, 1] == w:
+                                    sig = esig_old[o, so]
+                                    found = True
                 sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
                     de, matp[M, 2], matp[M, 3])
                 failed = 0
@@ -862,6 +890,22 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 sf = sig + viscous_stress(matp, M, de, dt)
                 fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
                 efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+    # 2b. every copy takes its triangle's stress and N_e (from the computed copy)
+    ti.loop_config(serialize=serial)
+    for a in range(n):
+        for s in range(ecnt[a]):
+            if emult[a, s] == 0:
+                b = elem[a, s, 0]
+                c = elem[a, s, 1]
+                for t in ti.static(range(2)):
+                    o, u, w = b, c, a
+                    if ti.static(t == 1):
+                        o, u, w = c, a, b
+                    if o < a:
+                        for so in range(ecnt[o]):
+                            if elem[o, so, 0] == u and elem[o, so, 1] == w and emult[o, so] > 0:
+                                esig[a, s] = esig[o, so]
+                                ncov[a, s] = ncov[o, so]
     # 3. gather per particle
     ti.loop_config(serialize=serial)
     for i in range(n):
@@ -892,18 +936,16 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                     if d[4] > 0.0:
                         hit = 1
                     cnt += mw
-                    # mark the engine slots of i's partners in this element
-                    for t in ti.static(range(3)):
-                        u = o
-                        if ti.static(t == 1):
-                            u = e1
-                        if ti.static(t == 2):
-                            u = e2
-                        if u > i:
-                            for k in range(encnt[i]):
-                                if enbr[i, k] == u:
-                                    cskip[i, k] = 1
             xforce[i] = f
+            # no DEM contact with a same-body Eq. 1 neighbour when either of the two is
+            # in an element: the elements carry their interaction (both lists sorted)
+            q = 0
+            for k in range(encnt[i]):
+                j = enbr[i, k]
+                while q < ncnt[i] and nbr[i, q] < j:
+                    q += 1
+                if q < ncnt[i] and nbr[i, q] == j and (icnt[i] > 0 or icnt[j] > 0):
+                    cskip[i, k] = 1
             st = pstate[i]
             if cnt > 0:
                 inv = 1.0 / cnt

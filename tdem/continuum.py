@@ -34,7 +34,7 @@ MAX_CANDIDATES = 1024
 RIGID_NODE = 8          # node flag: the node belongs to a free rigid block
 
 # arrays copied into the run segment's snapshot (the dynamic state)
-_SNAP = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags",
+_SNAP = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags", "elem", "ecnt", "esig",
          "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
          "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")
 
@@ -67,7 +67,8 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             fd = -alpha_l * ti.abs(f) * ti.math.sign(v0)
             den = 1.0 + 0.5 * alpha * dt
             v1 = (v0 * (1.0 - 0.5 * alpha * dt) + (f + fd) / m * dt) / den
-            vfree = v1
+            # the reaction balances the physical forces only (damping is not one)
+            vfree = (v0 * (1.0 - 0.5 * alpha * dt) + f / m * dt) / den
             fx = nfix[v]
             if fx & 1:
                 v1[0] = nvfix[v][0]
@@ -207,12 +208,16 @@ class Continuum:
         a["pinc"] = ti.ndarray(ti.i32, (n, pcmm.MAX_INCIDENT))
         a["picnt"] = ti.ndarray(ti.i32, (n,))
         a["emult"] = ti.ndarray(ti.i32, (n, E))
+        a["elem_old"] = ti.ndarray(ti.i32, (n, E, 2))
+        a["esig_old"] = _arr(4, (n, E))
+        a["ecnt_old"] = ti.ndarray(ti.i32, (n,))
         a["pflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
         a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
         self._alloc_lists()
         self._setup_blocks()
         self._setup_couples(couples)
         self.nr = {}
+        self.carry_stress = True
         self.snap = {}
 
     # ------------------------------------------------------------------ set-up
@@ -262,10 +267,13 @@ class Continuum:
             for k in range(3):
                 np.minimum.at(ns, b.triangles[:, k], alt)
             size.append(ns)
+            step = float(alt.min()) / b.material.p_wave_speed
             if not b.kinematic() and not b.rigid:
                 # a block whose every node has a prescribed velocity moves as told
-                # whatever its stiffness: it does not limit the step
-                self._crit = min(self._crit, float(alt.min()) / b.material.p_wave_speed)
+                # whatever its stiffness: it does not limit the step (unless nothing does)
+                self._crit = min(self._crit, step)
+            else:
+                self._crit_driven = min(getattr(self, "_crit_driven", math.inf), step)
             off += len(b.vertices)
         self.nv = off
         nv, nt = max(off, 1), max(sum(len(t) for t in tris), 1)
@@ -442,6 +450,8 @@ class Continuum:
     def critical_dt(self):
         """Shortest element altitude / c_p over the initial PCMM elements and the
         block triangles (the Courant step of the element model)."""
+        if math.isinf(self._crit):
+            return getattr(self, "_crit_driven", math.inf)
         return self._crit
 
     def before_forces(self, sim, dt, reach):
@@ -459,8 +469,9 @@ class Continuum:
                         a["cand"], a["ccnt"], a["nbr"], a["ncnt"], a["ring"], a["rang"],
                         a["elem"], a["ecnt"], a["earea"], a["ncov"], a["esig"], a["efor"],
                         a["ede"], a["psig"], a["peps"], a["pstate"], a["xforce"], e["nbr"],
-                        e["ncnt"], e["cskip"], a["pinc"], a["picnt"], a["emult"], a["pflags"], float(dt),
-                        serial)
+                        e["ncnt"], e["cskip"], a["pinc"], a["picnt"], a["emult"], a["pflags"],
+                        a["elem_old"], a["esig_old"], a["ecnt_old"], float(dt),
+                        self.carry_stress, serial)
         if self.nv:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],

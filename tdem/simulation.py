@@ -541,8 +541,9 @@ class Simulation:
     def non_reflecting(self, target, normal=None):
         """Viscous (Lysmer–Kuhlemeyer) non-reflecting boundary on particles or block
         nodes: the traction −ρ·c_p·v_n on the normal and −ρ·c_s·v_s on the tangential
-        velocity, over the point's tributary length (2R for a particle, half its two
-        boundary edges for a node), ρ, c_p, c_s of its material.
+        velocity, over the point's tributary length (for particles, half the
+        distances to their neighbours along the boundary line given; for nodes, half
+        their two boundary edges), ρ, c_p, c_s of its material.
 
         ``target``: particle indices (or a :class:`ParticleGroup`) of PCMM particles,
         a :class:`Block` (all its boundary nodes) or ``(block, nodes)``. ``normal``:
@@ -604,7 +605,7 @@ class Simulation:
                     n[k] = out / max(np.linalg.norm(out), 1e-300)
             else:
                 n = self._unit_normals(normal, len(ids))
-            area = 2.0 * rad[ids]
+            area = self._tributary(pos[ids], rad[ids])
             kind = "p"
         rho = mat.density
         cp = mat.p_wave_speed
@@ -615,6 +616,30 @@ class Simulation:
         self._nonreflect.append((kind, ids, coef, block))
         if self._cont is not None:
             self._cont.set_non_reflecting(kind, ids, coef)
+
+    @staticmethod
+    def _tributary(x, r):
+        """Tributary length of each point of a boundary line of particles: half the
+        distances to its two nearest neighbours on the line, or half the one of an
+        end point (both neighbours on one side); 2R for a lone particle."""
+        out = 2.0 * r.copy()
+        if len(x) < 2:
+            return out
+        for k in range(len(x)):
+            d = x - x[k]
+            dist = np.linalg.norm(d, axis=1)
+            dist[k] = np.inf
+            order = np.argsort(dist)
+            a = order[0]
+            if len(x) == 2:
+                out[k] = 0.5 * dist[a]
+                continue
+            b = order[1]
+            if np.dot(d[a], d[b]) > 0.0:          # both on one side: an end point
+                out[k] = 0.5 * dist[a]
+            else:
+                out[k] = 0.5 * (dist[a] + dist[b])
+        return out
 
     @staticmethod
     def _unit_normals(normal, k):

@@ -1,0 +1,183 @@
+"""Biaxial tests with rolling resistance (Jiang, Yu & Harris 2005, §5): specimen
+preparation, servo-controlled confinement, friction angles, and the Dask sweep.
+
+The default tests use small specimens (a few hundred discs) so that they run in a
+couple of minutes; the tests on the paper's 1008-disc specimen are marked slow.
+"""
+import math
+import multiprocessing
+
+import numpy as np
+import pytest
+
+import tdem
+from cases import biaxial
+from tdem import specimen
+
+SIGMA = 200e3
+
+
+# ------------------------------------------------------------------ helpers
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    """A 300-disc specimen consolidated to 200 kPa, saved (each test loads a copy)."""
+    spec = specimen.prepare(n=300, confining=SIGMA, seed=3)
+    path = tmp_path_factory.mktemp("biaxial") / "small.h5"
+    spec.save(path)
+    return spec, path
+
+
+def test_gradation_matches_the_paper():
+    d = specimen.gradation(5000, seed=1)
+    g = specimen.grading(d)
+    assert d.min() >= 6e-3 and d.max() <= 9e-3
+    assert g["d50"] == pytest.approx(7.6e-3, rel=0.02)
+    assert g["cu"] == pytest.approx(1.3, abs=0.03)
+
+
+def test_prepared_specimen_reaches_its_void_ratio(small):
+    spec, _ = small
+    e = spec.void_ratio()
+    sh, sv = spec.stresses()
+    print(f"void ratio {e:.4f} (target 0.25); friction steps {spec.history['friction']}; "
+          f"sigma_h {sh:.0f} Pa, sigma_v {sv:.0f} Pa")
+    assert abs(e - 0.25) <= 0.01
+    # at rest under the isotropic stress, friction back to the material's value
+    assert spec.law.friction == 0.5
+    assert spec.history["friction"][-1] == 0.5
+    assert abs(sh / SIGMA - 1.0) < 0.05 and abs(sv / SIGMA - 1.0) < 0.05
+    # stiff contacts: no overlap reaches 1 % of the smallest diameter at 200 kPa
+    c = spec.sim.contacts.numpy()
+    assert c["overlap"].max() < 0.01 * 6e-3
+
+
+def test_servo_holds_sigma_h_through_shearing(small):
+    _, path = small
+    spec = specimen.Specimen.load(path)
+    r = specimen.shear(spec, strain_rate=1.0, axial_strain=0.08)
+    hold = biaxial.sigma_h_hold(r)          # largest error of 0.5 %-strain averages
+    ea = r["axial_strain"]
+    print(f"sigma_h held within {100 * hold:.2f} % over {100 * ea[-1]:.1f} % axial strain")
+    assert ea[-1] >= 0.08
+    assert hold < 0.02
+    # the mean over the whole shearing stage is on target too
+    assert np.mean(r["sigma_h"][ea > 0.005]) == pytest.approx(SIGMA, rel=0.01)
+    # the vertical stress rises above sigma_h: the specimen is sheared
+    phi = specimen.friction_angles(r)
+    assert 10.0 < phi["phi_peak"] < 40.0
+    assert r["sigma_v"].max() > 1.5 * SIGMA
+
+
+def test_shear_with_rolling_resistance_runs_and_is_stronger(small):
+    _, path = small
+    out = {}
+    for name, rolling in (("none", None), ("m1", tdem.RollingResistance(delta=1.6, model=1))):
+        spec = specimen.Specimen.load(path)
+        r = specimen.shear(spec, rolling=rolling, strain_rate=1.0, axial_strain=0.05)
+        out[name] = specimen.friction_angles(r)["phi_peak"]
+    print(f"small specimen, 5 % strain: phi peak none {out['none']:.1f}, "
+          f"Model 1 delta 1.6 {out['m1']:.1f}")
+    assert out["m1"] > out["none"] + 5.0
+
+
+def test_bad_input_names_the_argument(small, tmp_path):
+    with pytest.raises(tdem.InputError, match="void_ratio"):
+        specimen.prepare(n=50, void_ratio=-0.1)
+    with pytest.raises(tdem.InputError, match="n must"):
+        specimen.prepare(n=2)
+    with pytest.raises(tdem.InputError, match="cu"):
+        specimen.gradation(10, cu=0.9)
+    with pytest.raises(tdem.InputError, match="strain_rate"):
+        specimen.shear(small[0], strain_rate=0.0)
+    with pytest.raises(tdem.InputError, match="rolling"):
+        specimen.shear(small[0], rolling=0.4)
+    with pytest.raises(tdem.InputError, match="model"):
+        biaxial.check_material(3, 0.4)
+    with pytest.raises(tdem.InputError, match="delta"):
+        biaxial.check_material(1, -0.4)
+    with pytest.raises(ValueError, match="confining"):
+        biaxial.main(["--confining", "-5", "--out", str(tmp_path)])
+
+
+def test_friction_angle_formula():
+    ea = np.linspace(0.0, 0.1, 101)
+    sv = np.full(101, 3.0)
+    sv[50] = 5.0   # one record, kept as it is without smoothing
+    r = {"axial_strain": ea, "sigma_v": sv, "sigma_h": np.ones(101)}
+    phi = specimen.friction_angles(r, smoothing=0.0)
+    assert phi["phi_peak"] == pytest.approx(math.degrees(math.asin(4.0 / 6.0)))
+    assert phi["phi_residual"] == pytest.approx(30.0)       # sin phi = 2/4
+
+
+# ------------------------------------------------------------------ the sweep
+TINY = {"n": 120, "strain_rate": 2.0, "axial_strain": 0.03, "seed": 5}
+
+
+def test_dask_sweep_equals_serial_runs():
+    tasks = biaxial.sweep_tasks(dict(TINY, materials=[(0, 0.0), (1, 0.4)]),
+                                confining=(SIGMA,))
+    assert len(tasks) == 2
+    swept = biaxial.run_sweep(tasks, workers=2)
+    # the same tasks one after the other, in one fresh process
+    ctx = multiprocessing.get_context("spawn")
+    with ctx.Pool(1) as pool:
+        serial = pool.apply(biaxial.run_serial, (tasks,))
+    for a, b in zip(swept, serial):
+        assert a["task"] == b["task"]
+        print(f"{a['name']}: phi peak {a['phi']['phi_peak']:.6f} (Dask) "
+              f"{b['phi']['phi_peak']:.6f} (serial)")
+        assert a["phi"] == b["phi"]
+        for k in ("sigma_v", "sigma_h", "axial_strain", "volumetric_strain"):
+            np.testing.assert_array_equal(a["curves"][k], b["curves"][k])
+    assert swept[0]["name"] == "none" and swept[1]["name"] == "model1_delta0.4"
+    assert swept[0]["phi"] != swept[1]["phi"]
+
+
+# ------------------------------------------------------------------ the paper's specimen
+@pytest.fixture(scope="module")
+def paper_runs(tmp_path_factory):
+    """The paper's 1008-disc specimen at 100, 200, 400 kPa, compressed to 15 % at
+    0.5 /s with no rolling resistance, Model 1 at delta = 0.4, 0.8, 1.6 and Model 2
+    at delta = 0.4 (200 kPa) and the three Fig. 12 materials at 100 and 400 kPa."""
+    folder = tmp_path_factory.mktemp("biaxial_paper")
+    runs = {}
+    base = {"n": 1008, "strain_rate": 0.5, "axial_strain": 0.15, "seed": 0}
+    plan = [(SIGMA, m, d) for m, d in ((0, 0.0), (1, 0.4), (1, 0.8), (1, 1.6), (2, 0.4))]
+    plan += [(s, m, d) for s in (100e3, 400e3) for m, d in biaxial.MATERIALS]
+    for s, m, d in plan:
+        r = biaxial.run_test(dict(base, confining=s, model=m, delta=d), specimen_dir=folder)
+        runs[(s, m, d)] = r
+        print(f"{s / 1e3:g} kPa {r['name']}: {r['phi']['phi_peak']:.2f}/"
+              f"{r['phi']['phi_residual']:.2f} deg, sigma_h within {100 * r['hold']:.2f} %")
+    return runs
+
+
+@pytest.mark.slow
+def test_paper_specimen_void_ratio_and_servo(paper_runs):
+    for r in paper_runs.values():
+        assert abs(r["before"]["void_ratio"] - 0.25) <= 0.01
+        assert r["hold"] < 0.02
+
+
+@pytest.mark.slow
+def test_no_rolling_resistance_peak_angle(paper_runs):
+    phi = paper_runs[(SIGMA, 0, 0.0)]["phi"]["phi_peak"]
+    assert 20.0 <= phi <= 29.0          # the paper: 24.4
+
+
+@pytest.mark.slow
+def test_model1_raises_phi_monotonically_with_delta(paper_runs):
+    phis = [paper_runs[(SIGMA, m, d)]["phi"]["phi_peak"]
+            for m, d in ((0, 0.0), (1, 0.4), (1, 0.8), (1, 1.6))]
+    assert np.all(np.diff(phis) > 0), phis
+
+
+@pytest.mark.slow
+def test_model2_between_none_and_model1(paper_runs):
+    """Mean peak phi over the three confining stresses at delta = 0.4."""
+    def mean(m, d):
+        return np.mean([paper_runs[(s, m, d)]["phi"]["phi_peak"]
+                        for s in (100e3, SIGMA, 400e3)])
+    none, m1, m2 = mean(0, 0.0), mean(1, 0.4), mean(2, 0.4)
+    print(f"mean peak phi: none {none:.2f}, Model 2 {m2:.2f}, Model 1 {m1:.2f}")
+    assert none < m2 < m1
