@@ -1,0 +1,725 @@
+"""Biaxial tests with rolling resistance of Jiang, Yu & Harris (2005), §5 (Figs. 11-13).
+
+Set-up (the paper's §5.1)
+-------------------------
+1008 discs, d = 6-9 mm (d50 = 7.6 mm, C_u = 1.3), specimen 180 x 306.7 mm at a planar
+void ratio of 0.25, k_n = 2e8 N/m, k_s = 1.5e8 N/m, inter-particle friction 0.5;
+walls frictionless and without rolling resistance. Isotropic consolidation to
+sigma_h = 100, 200 or 400 kPa, then vertical compression at a constant strain rate
+with sigma_h held by servo-controlled side walls. The mobilised friction angle is
+sin(phi) = (sigma_v - sigma_h)/(sigma_v + sigma_h). Rolling resistance (shape
+parameter delta, Model 1 elastic-perfectly plastic or Model 2 elastic-brittle) is
+off while the specimen is made and switched on for the compression, so that every
+test of one confining stress starts from the same specimen.
+
+Targets (the paper's text): peak/residual phi = 24.4°/19.3° without rolling
+resistance, 29.0°/23.0° for Model 1 and 26.5°/20.7° for Model 2 at delta = 0.4,
+42.3°/35.8° for Model 1 at delta = 1.6 (Figs. 12-13).
+
+Decisions the paper leaves open
+-------------------------------
+- Specimen preparation: the paper uses multi-layer under-compaction (its ref. 58).
+  Here (``tdem.specimen.prepare``): discs on a loose lattice of the specimen's
+  aspect ratio, walls closing in at a uniform strain rate to e = 0.31, then
+  isotropic consolidation by four servo walls at the confining stress with the
+  friction at 1.0, lowered step by step (x 0.7 each time) under the same stress
+  until the void ratio is at most 0.25 + 0.002, then restored to 0.5. The size of
+  the specimen follows from its discs and void ratio: about 180 x 305 mm (the
+  paper: 180 x 306.7 mm), see the summary.
+- Grading: piecewise linear by area through d10, d50 = 7.6 mm and d60 = 1.3 d10
+  (``tdem.specimen.gradation``); the paper's Fig. 9 curve itself is not given.
+- Density 2650 kg/m³ (not given), no gravity, local damping 0.7 (the paper's
+  damping is not given), time step 0.2 x the critical step.
+- Strain rate: the paper's 0.2 %/min would take ~10^10 steps. The compression
+  runs at a true strain rate (change of height over current height) of 0.5 /s
+  (quick) or 0.1 /s (paper) at 200 kPa, scaled by sqrt(sigma_h / 200 kPa) at other
+  confining stresses, which keeps the inertial number I = eps_dot d50
+  sqrt(rho/sigma_h) the same (4.4e-4 quick, 8.8e-5 paper). The rate still shows:
+  on one 200 kPa specimen without rolling resistance the peak phi was 28.2°,
+  22.8°, 21.6° and 20.7° at 1, 0.5, 0.25 and 0.1 /s (residual 24.1°, 21.2°,
+  17.0°, 17.8°), so the quick preset reads about 2° high.
+- Scatter: a single 1008-disc test varies by about ±1-2° in peak phi with the
+  specimen (seed, confining stress) and, on several threads, from run to run
+  (the wall forces are summed with atomic additions, whose order varies, and
+  the servo feeds them back). The sweep runs on one thread per task and is
+  reproducible.
+- The servo walls of the engine are proportional controllers, which lag behind a
+  moving target; the side walls' target force gets an integral correction from the
+  host every 0.05 % of axial strain (``tdem.specimen.shear``), which keeps sigma_h
+  within about 1 % (summary: ``sigma_h_hold``).
+- Peak: the largest sin(phi) of stresses averaged over 0.2 % axial strain.
+  Residual: mean stresses over the last quarter of the test (axial strain from
+  0.75 x the final one, 12 % quick / 20 % paper). The paper does not say where it
+  takes the residual value.
+- Figs. 12-13: the paper's phi are "deduced from the envelopes". Each test gives
+  its own phi; the sweep also fits q = a + p sin(phi) (p = (sigma_v + sigma_h)/2,
+  q = (sigma_v - sigma_h)/2) over the three confining stresses and reports both.
+
+Presets
+-------
+quick (about 2 minutes on 2 cores): one 1008-disc specimen at --confining
+(200 kPa), four tests (no rolling resistance, Model 1 and Model 2 at delta = 0.4,
+Model 1 at delta = 1.6) to 12 % axial strain at 0.5 /s (faster than quasi-static,
+see above). With --delta/--model only that test runs. paper: 0.1 /s to 20 %, the
+same four tests at 200 kPa plus the three Fig. 12 materials at 100 and 400 kPa
+(envelopes); about 30-40 minutes on 2 cores.
+
+Sweep (--sweep)
+---------------
+The delta-phi study as independent tasks on Dask (``distributed.LocalCluster`` of
+--workers processes with one thread each, or an existing cluster with --scheduler
+ADDRESS; its workers must be able to import ``cases.biaxial``, e.g. started from the
+repository's root). One task prepares each specimen (one per confining stress) and
+returns its checkpoint; one task per test compresses a copy of it. paper: delta =
+0, 0.1 ... 1.6 for Models 1 and 2 at 100, 200 and 400 kPa (99 tests, 0.1 /s at
+200 kPa to 20 %: several hours on 2 cores); quick: delta = 0, 0.4, 0.8, 1.6 for
+Model 1 and delta = 0.4 for Model 2 at the three stresses (15 tests, 0.5 /s at
+200 kPa to 10 %, about 6 minutes). Results are gathered into ``sweep.h5`` (a group
+per test) and plotted: ``fig12_envelopes.png`` (peak and residual envelopes of the
+three Fig. 12 materials with the paper's slopes) and ``fig13_phi_delta.png`` (phi
+against delta, mean and range over the confining stresses, the paper's values
+beside).
+"""
+import math
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from cases import _common as common
+
+CASE = "biaxial"
+
+CONFINING = (100e3, 200e3, 400e3)
+#: peak/residual phi (degrees) from the paper's text: (model, delta) -> (peak, residual)
+TARGETS = {
+    (0, 0.0): (24.4, 19.3),
+    (1, 0.4): (29.0, 23.0),
+    (2, 0.4): (26.5, 20.7),
+    (1, 1.6): (42.3, 35.8),
+}
+#: the paper's Fig. 11 / 12 materials: (model, delta), model 0 = no rolling resistance
+MATERIALS = ((0, 0.0), (1, 0.4), (2, 0.4))
+
+PRESETS = {
+    "quick": {
+        "n": 1008, "strain_rate": 0.5, "axial_strain": 0.12,
+        "tests": ((0, 0.0), (1, 0.4), (2, 0.4), (1, 1.6)),
+        "envelope_confining": (), "vtu_snapshots": 12,
+        "sweep": {"n": 1008, "strain_rate": 0.5, "axial_strain": 0.10,
+                  "materials": [(1, d) for d in (0.0, 0.4, 0.8, 1.6)] + [(2, 0.4)]},
+    },
+    "paper": {
+        "n": 1008, "strain_rate": 0.1, "axial_strain": 0.20,
+        "tests": ((0, 0.0), (1, 0.4), (2, 0.4), (1, 1.6)),
+        "envelope_confining": (100e3, 400e3), "vtu_snapshots": 40,
+        "sweep": {"n": 1008, "strain_rate": 0.1, "axial_strain": 0.20,
+                  "materials": [(1, round(0.1 * k, 1)) for k in range(17)]
+                  + [(2, round(0.1 * k, 1)) for k in range(1, 17)]},
+    },
+}
+DENSITY = 2650.0
+SEED = 0
+
+
+# ------------------------------------------------------------------ one test
+def material_name(model, delta):
+    """'none', 'model1_delta0.4', ... (model 0 or delta 0: no rolling resistance)."""
+    if model == 0 or delta == 0.0:
+        return "none"
+    return f"model{model}_delta{delta:g}"
+
+
+def rolling_for(model, delta):
+    import tdem
+    if model == 0 or delta == 0.0:
+        return None
+    return tdem.RollingResistance(delta=delta, model=model)
+
+
+def check_material(model, delta):
+    """Validate a (model, delta) pair; raises tdem.InputError naming the bad one."""
+    from tdem.errors import InputError
+    if model not in (0, 1, 2):
+        raise InputError(f"model must be 0 (none), 1 or 2, got {model!r}")
+    try:
+        d = float(delta)
+    except (TypeError, ValueError):
+        raise InputError(f"delta must be a number >= 0, got {delta!r}") from None
+    if not (d >= 0.0 and math.isfinite(d)):
+        raise InputError(f"delta must be a number >= 0, got {delta!r}")
+    if model == 0 and d != 0.0:
+        raise InputError(f"delta must be 0 without rolling resistance (model 0), got {delta!r}")
+    return model, d
+
+
+_SPECIMENS = {}     # this process's prepared specimens: key -> checkpoint bytes
+
+
+def specimen_key(task):
+    """What a specimen depends on: (n, confining stress, seed)."""
+    return (int(task["n"]), float(task["confining"]), int(task.get("seed", SEED)))
+
+
+def prepare_specimen(task):
+    """Prepare the specimen of ``task`` (a dict: n, confining, seed, threads, arch) and
+    return its checkpoint (:meth:`tdem.specimen.Specimen.save`) as bytes."""
+    from tdem import specimen
+    n, confining, seed = specimen_key(task)
+    spec = specimen.prepare(n=n, confining=confining, seed=seed, density=DENSITY,
+                            threads=task.get("threads"), arch=task.get("arch"))
+    with tempfile.TemporaryDirectory(prefix="biaxial_") as tmp:
+        path = Path(tmp) / "specimen.h5"
+        spec.save(path)
+        return path.read_bytes()
+
+
+def load_specimen(data, arch=None, keep=None):
+    """A specimen from checkpoint bytes; ``keep``: also write them to this path."""
+    from tdem import specimen
+    if keep is not None:
+        Path(keep).parent.mkdir(parents=True, exist_ok=True)
+        Path(keep).write_bytes(data)
+    with tempfile.TemporaryDirectory(prefix="biaxial_") as tmp:
+        path = Path(tmp) / "specimen.h5"
+        path.write_bytes(data)
+        return specimen.Specimen.load(path, arch=arch)
+
+
+def specimen_for(task, directory=None):
+    """The prepared specimen of ``task``: made once per process and key
+    (:func:`specimen_key`) and kept as checkpoint bytes; every call loads a fresh copy,
+    so a test gives the same numbers whether or not its specimen was made before.
+    ``directory``: also save the checkpoint there."""
+    key = specimen_key(task)
+    if key not in _SPECIMENS:
+        _SPECIMENS[key] = prepare_specimen(task)
+    keep = None
+    if directory is not None:
+        keep = Path(directory) / f"specimen_n{key[0]}_{key[1] / 1e3:g}kPa_seed{key[2]}.h5"
+    return load_specimen(_SPECIMENS[key], arch=task.get("arch"), keep=keep)
+
+
+def strain_rate_at(rate, confining, reference=200e3):
+    """Strain rate at ``confining`` with the inertial number of ``rate`` at
+    ``reference``: I = rate d50 sqrt(rho/sigma) is kept, rate ∝ sqrt(sigma)."""
+    return rate * math.sqrt(confining / reference)
+
+
+def run_test(task, output=None, vtu_snapshots=0, specimen_dir=None, spec=None):
+    """One biaxial test: the specimen of ``task`` compressed with its rolling resistance.
+
+    ``task``: dict with n, confining (Pa), model (0, 1, 2), delta, strain_rate (1/s),
+    axial_strain, seed, threads, arch. ``output``: a folder for the VTU series and
+    ``monitors.h5`` (the wall stresses and the specimen's size; None: none).
+    ``specimen_dir``: a folder to save the specimen's checkpoint in (None: none).
+    ``spec``: the specimen to compress (None: :func:`specimen_for` the task).
+
+    Returns a dict: the task, the curves (numpy arrays), the friction angles
+    (:func:`tdem.specimen.friction_angles`), the specimen's state before compression,
+    ``hold`` (:func:`sigma_h_hold`), the steps and the wall-clock time, and ``spec``
+    (the specimen after compression, only with ``output``).
+    """
+    from tdem import specimen
+    clock = common.Stopwatch()
+    model, delta = check_material(task["model"], task["delta"])
+    if spec is None:
+        spec = specimen_for(task, specimen_dir)
+    before = spec.state()
+    writer = None
+    if output is not None:
+        sim = spec.sim
+        steps = task["axial_strain"] / task["strain_rate"] / sim.dt
+        every = max(1, int(steps / max(vtu_snapshots, 1)))
+        writer = common.start_output(sim, output, every)
+    curves = specimen.shear(spec, rolling=rolling_for(model, delta),
+                            strain_rate=task["strain_rate"], axial_strain=task["axial_strain"])
+    common.finish_output(writer)
+    phi = specimen.friction_angles(curves)
+    return {"task": dict(task), "name": material_name(model, delta), "curves": curves,
+            "phi": phi, "before": before, "hold": sigma_h_hold(curves),
+            "steps": spec.sim.steps, "wall_s": clock(), "spec": spec if output else None}
+
+
+def sigma_h_hold(curves, window=0.005, skip=0.005):
+    """Largest relative deviation of sigma_h from its target, averaged over windows of
+    ``window`` axial strain, after the first ``skip`` of axial strain."""
+    ea = np.asarray(curves["axial_strain"])
+    sh = np.asarray(curves["sigma_h"]) / curves["sigma_h_target"] - 1.0
+    edges = np.arange(skip, ea[-1] + 1e-12, window)
+    worst = 0.0
+    for a, b in zip(edges[:-1], edges[1:]):
+        m = (ea >= a) & (ea < b)
+        if m.any():
+            worst = max(worst, abs(float(sh[m].mean())))
+    return worst
+
+
+# ------------------------------------------------------------------ the sweep
+def _single_thread(task):
+    os.environ["TDEM_THREADS"] = "1"
+    return dict(task, threads=1)
+
+
+def _plain_result(r):
+    return {"task": r["task"], "name": r["name"], "phi": r["phi"], "before": r["before"],
+            "hold": r["hold"], "steps": r["steps"], "wall_s": r["wall_s"],
+            "curves": {k: np.asarray(v) for k, v in r["curves"].items()}}
+
+
+def prepare_task(task):
+    """Sweep task: prepare a specimen on one thread; returns its checkpoint bytes."""
+    return prepare_specimen(_single_thread(task))
+
+
+def shear_task(task, specimen_bytes):
+    """Sweep task: compress a copy of the specimen ``specimen_bytes`` on one thread;
+    returns plain results (no simulation object)."""
+    task = _single_thread(task)
+    spec = load_specimen(specimen_bytes, arch=task.get("arch"))
+    return _plain_result(run_test(task, spec=spec))
+
+
+def run_task(task):
+    """One test on one thread in this process (its specimen made here, once per key)."""
+    task = _single_thread(task)
+    key = specimen_key(task)
+    if key not in _SPECIMENS:
+        _SPECIMENS[key] = prepare_task(task)
+    return shear_task(task, _SPECIMENS[key])
+
+
+def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None):
+    """The tasks of a sweep: every material of ``cfg`` at every confining stress; the
+    strain rate of ``cfg`` is the one at 200 kPa (:func:`strain_rate_at`)."""
+    materials = cfg["materials"] if materials is None else materials
+    return [{"n": cfg["n"], "confining": float(s), "model": int(m), "delta": float(d),
+             "strain_rate": strain_rate_at(cfg["strain_rate"], float(s)),
+             "axial_strain": cfg["axial_strain"], "seed": cfg.get("seed", SEED), "arch": arch}
+            for s in confining for (m, d) in materials]
+
+
+def run_sweep(tasks, scheduler=None, workers=2):
+    """Run ``tasks`` on Dask and return their results in order.
+
+    One task per specimen (:func:`prepare_task`, one per :func:`specimen_key`), then
+    one per test (:func:`shear_task`), which receives its specimen's checkpoint from
+    the scheduler, so workers need no shared disk. ``scheduler``: address of an
+    existing cluster; None starts a ``distributed.LocalCluster`` of ``workers``
+    processes with one thread each."""
+    from distributed import Client, LocalCluster
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                               dashboard_address=None, env={"TDEM_THREADS": "1"})
+        client = Client(cluster)
+    else:
+        client = Client(scheduler)
+    try:
+        specimens = {}
+        for t in tasks:
+            key = specimen_key(t)
+            if key not in specimens:
+                specimens[key] = client.submit(prepare_task, t, pure=False)
+        futures = [client.submit(shear_task, t, specimens[specimen_key(t)], pure=False)
+                   for t in tasks]
+        return client.gather(futures)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def run_serial(tasks):
+    """Run ``tasks`` one after the other in this process (same numbers as the sweep)."""
+    return [run_task(t) for t in tasks]
+
+
+def envelope(points):
+    """Least-squares line q = a + b p through (p, q) points; returns phi (degrees,
+    sin(phi) = b), the apparent cohesion c = a / cos(phi) and phi through the origin
+    (sin(phi) = sum(p q)/sum(p²))."""
+    p = np.array([x[0] for x in points], dtype=float)
+    q = np.array([x[1] for x in points], dtype=float)
+    origin = math.degrees(math.asin(min(1.0, float(np.sum(p * q) / np.sum(p * p)))))
+    if len(p) < 2:
+        return {"phi": origin, "cohesion": 0.0, "phi_through_origin": origin}
+    b, a = np.polyfit(p, q, 1)
+    phi = math.degrees(math.asin(float(np.clip(b, -1.0, 1.0))))
+    return {"phi": phi, "cohesion": float(a / math.cos(math.radians(phi))),
+            "phi_through_origin": origin}
+
+
+def envelopes(results):
+    """Peak and residual envelopes per material over the confining stresses."""
+    out = {}
+    for name in sorted({r["name"] for r in results}):
+        rs = [r for r in results if r["name"] == name]
+        peak = [(0.5 * (r["phi"]["sigma_v_peak"] + r["phi"]["sigma_h_at_peak"]),
+                 0.5 * (r["phi"]["sigma_v_peak"] - r["phi"]["sigma_h_at_peak"])) for r in rs]
+        res = [(0.5 * (r["phi"]["sigma_v_residual"] + r["phi"]["sigma_h_residual"]),
+                0.5 * (r["phi"]["sigma_v_residual"] - r["phi"]["sigma_h_residual"])) for r in rs]
+        out[name] = {"peak": envelope(peak), "residual": envelope(res), "peak_points": peak,
+                     "residual_points": res,
+                     "confining": [r["task"]["confining"] for r in rs],
+                     "phi_peak_tests": [r["phi"]["phi_peak"] for r in rs],
+                     "phi_residual_tests": [r["phi"]["phi_residual"] for r in rs]}
+    return out
+
+
+def save_results(path, results, extra=None):
+    """All tests in one HDF5 file: a group per test (``sigma200kPa/model1_delta0.4``)
+    with the curves as datasets and the task, friction angles and state as
+    attributes; ``extra`` (a dict of JSON-able values) as root attributes."""
+    import json
+
+    import h5py
+    with h5py.File(path, "w") as f:
+        for r in results:
+            g = f.require_group(f"sigma{r['task']['confining'] / 1e3:g}kPa/{r['name']}")
+            for k, v in r["curves"].items():
+                if np.ndim(v):
+                    g.create_dataset(k, data=np.asarray(v, dtype=float))
+                else:
+                    g.attrs[k] = float(v)
+            for k, v in r["phi"].items():
+                g.attrs[k] = float(v)
+            g.attrs["task"] = json.dumps(common._plain(r["task"]))
+            g.attrs["before"] = json.dumps(common._plain(r["before"]))
+            g.attrs["sigma_h_hold"] = float(r["hold"])
+            g.attrs["wall_s"] = float(r["wall_s"])
+        for k, v in (extra or {}).items():
+            f.attrs[k] = json.dumps(common._plain(v))
+    return path
+
+
+# ------------------------------------------------------------------ plots
+_STYLE = {"none": ("k", "No rolling resistance"),
+          "model1_delta0.4": ("tab:red", "Model 1, δ = 0.4"),
+          "model2_delta0.4": ("tab:blue", "Model 2, δ = 0.4"),
+          "model1_delta1.6": ("tab:green", "Model 1, δ = 1.6")}
+
+
+def _label(name):
+    return _STYLE.get(name, (None, name))
+
+
+def plot_fig11(results, png, confining):
+    plt = common.pyplot()
+    from tdem.specimen import smooth
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for r in results:
+        c = r["curves"]
+        color, label = _label(r["name"])
+        ea = 100 * c["axial_strain"]
+        step = max(float(np.median(np.diff(c["axial_strain"]))), 1e-12)
+        w = int(round(0.002 / step))
+        q = 0.5 * (smooth(c["sigma_v"], w) - smooth(c["sigma_h"], w)) / 1e3
+        a.plot(ea, q, color=color, lw=1.2,
+               label=f"{label}: φ = {r['phi']['phi_peak']:.1f}°/{r['phi']['phi_residual']:.1f}°")
+        b.plot(ea, 100 * c["volumetric_strain"], color=color, lw=1.2, label=label)
+    a.set_xlabel("axial strain (%)")
+    a.set_ylabel("(σ_v − σ_h)/2 (kPa)")
+    a.set_title("(a) deviatoric stress", fontsize=10)
+    a.legend(fontsize=8)
+    b.set_xlabel("axial strain (%)")
+    b.set_ylabel("volumetric strain ε_a + ε_h (%), compression +")
+    b.set_title("(b) volumetric strain", fontsize=10)
+    b.legend(fontsize=8)
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"Biaxial tests at σ_h = {confining / 1e3:g} kPa (Jiang et al. 2005, Fig. 11)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=130)
+    plt.close(fig)
+
+
+def plot_fig12(env, png):
+    plt = common.pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    paper = {"none": TARGETS[(0, 0.0)], "model1_delta0.4": TARGETS[(1, 0.4)],
+             "model2_delta0.4": TARGETS[(2, 0.4)]}
+    for ax, kind, col in ((axes[0], "peak", 0), (axes[1], "residual", 1)):
+        for name, e in env.items():
+            if name not in paper and len(env) > 4:
+                continue
+            color, label = _label(name)
+            pts = np.array(e[f"{kind}_points"]) / 1e3
+            line = ax.plot(pts[:, 0], pts[:, 1], "o", color=color)[0]
+            fit = e[kind]
+            pp = np.linspace(0, pts[:, 0].max() * 1.1, 20)
+            s = math.sin(math.radians(fit["phi"]))
+            a = fit["cohesion"] * math.cos(math.radians(fit["phi"])) / 1e3
+            ax.plot(pp, a + s * pp, "-", color=line.get_color(), lw=1,
+                    label=f"{label}: φ = {fit['phi']:.1f}°, c = {fit['cohesion'] / 1e3:.1f} kPa")
+            if name in paper:
+                sp = math.sin(math.radians(paper[name][col]))
+                ax.plot(pp, sp * pp, ":", color=line.get_color(), lw=1,
+                        label=f"paper: φ = {paper[name][col]}°")
+        ax.set_xlabel("(σ_v + σ_h)/2 (kPa)")
+        ax.set_ylabel("(σ_v − σ_h)/2 (kPa)")
+        ax.set_title(f"{kind} strength envelopes", fontsize=10)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+        ax.set_xlim(left=0)
+        ax.set_ylim(bottom=0)
+    fig.suptitle("Strength envelopes (Jiang et al. 2005, Fig. 12)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=130)
+    plt.close(fig)
+
+
+def plot_fig13(results, png):
+    plt = common.pyplot()
+    fig, ax = plt.subplots(figsize=(7, 4.6))
+    for model, marker in ((1, "o"), (2, "s")):
+        rs = [r for r in results if r["task"]["model"] in (model, 0)]
+        deltas = sorted({r["task"]["delta"] for r in rs})
+        if len(deltas) < 2 and model == 2:
+            rs = [r for r in results if r["task"]["model"] == 2]
+            deltas = sorted({r["task"]["delta"] for r in rs})
+        if not deltas:
+            continue
+        for kind, fill in (("phi_peak", "full"), ("phi_residual", "none")):
+            mean, lo, hi = [], [], []
+            for d in deltas:
+                v = [r["phi"][kind] for r in rs if r["task"]["delta"] == d]
+                mean.append(np.mean(v))
+                lo.append(np.mean(v) - np.min(v))
+                hi.append(np.max(v) - np.mean(v))
+            ax.errorbar(deltas, mean, yerr=[lo, hi], marker=marker, fillstyle=fill,
+                        color="tab:red" if model == 1 else "tab:blue", capsize=3, lw=1,
+                        label=f"Model {model}, {'peak' if kind == 'phi_peak' else 'residual'}"
+                              " (mean, range over σ_h)")
+    for (model, delta), (pk, rsd) in TARGETS.items():
+        mk = "*" if model != 2 else "P"
+        ax.plot([delta], [pk], mk, color="k", ms=10)
+        ax.plot([delta], [rsd], mk, color="0.5", ms=10)
+    ax.plot([], [], "*", color="k", ms=10, label="paper, peak (Model 1 / none)")
+    ax.plot([], [], "*", color="0.5", ms=10, label="paper, residual")
+    ax.plot([], [], "P", color="k", ms=9, label="paper, Model 2 at δ = 0.4")
+    ax.set_xlabel("shape parameter δ")
+    ax.set_ylabel("internal friction angle φ (°)")
+    ax.set_title("φ against δ (Jiang et al. 2005, Fig. 13)", fontsize=10)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(png, dpi=130)
+    plt.close(fig)
+
+
+def plot_specimen(spec, png, title):
+    plt = common.pyplot()
+    p = spec.sim.particles.numpy(stress=False)
+    x0, x1, y0, y1 = spec.box()
+    fig, ax = plt.subplots(figsize=(4.2, 6.5))
+    walls = [np.array([[x0, y0], [x1, y0]]), np.array([[x1, y0], [x1, y1]]),
+             np.array([[x1, y1], [x0, y1]]), np.array([[x0, y1], [x0, y0]])]
+    common.force_vector_plot(ax, p["position"], p["radius"], spec.sim.contacts.numpy(),
+                             walls=walls)
+    ax.set_title(title, fontsize=9)
+    ax.set_axis_off()
+    fig.tight_layout()
+    fig.savefig(png, dpi=130)
+    plt.close(fig)
+
+
+# ------------------------------------------------------------------ the case
+def _figures(results):
+    figs = {}
+    for r in results:
+        key = (r["task"]["model"] if r["task"]["delta"] else 0, r["task"]["delta"])
+        target = TARGETS.get(key)
+        s = f"{r['task']['confining'] / 1e3:g}kPa"
+        figs[f"phi_peak_{r['name']}_{s}"] = common.figure(
+            r["phi"]["phi_peak"], target[0] if target else None, "deg",
+            f"largest sin φ, at axial strain {100 * r['phi']['strain_at_peak']:.2f} %")
+        figs[f"phi_residual_{r['name']}_{s}"] = common.figure(
+            r["phi"]["phi_residual"], target[1] if target else None, "deg",
+            "mean stresses over the last quarter of the axial strain")
+    return figs
+
+
+def _extra(p):
+    p.add_argument("--delta", type=float, default=None,
+                   help="run one test with this shape parameter (0: no rolling resistance; "
+                        "default 0.4 with --model)")
+    p.add_argument("--model", type=int, default=None, choices=(0, 1, 2),
+                   help="rolling model of that test: 1 (default with --delta) or 2; 0 = none")
+    p.add_argument("--confining", type=float, default=200e3,
+                   help="confining stress sigma_h in Pa (default 200e3)")
+    p.add_argument("--sweep", action="store_true",
+                   help="run the delta-phi study on Dask (Figs. 12-13)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="with --sweep: address of an existing Dask scheduler")
+    p.add_argument("--workers", type=int, default=2,
+                   help="with --sweep: worker processes of the local cluster (default 2)")
+
+
+def _main_sweep(args, out, cfg, clock):
+    from tdem.errors import InputError
+    if args.workers < 1:
+        raise InputError(f"workers must be >= 1, got {args.workers!r}")
+    tasks = sweep_tasks(cfg["sweep"], arch=args.arch)
+    print(f"biaxial sweep ({args.preset}): {len(tasks)} tasks on "
+          f"{args.scheduler or f'a local cluster of {args.workers} workers'}", flush=True)
+    results = run_sweep(tasks, scheduler=args.scheduler, workers=args.workers)
+    env = envelopes(results)
+    save_results(out / "sweep.h5", results, extra={"envelopes": env})
+    plot_fig12(env, out / "fig12_envelopes.png")
+    plot_fig13(results, out / "fig13_phi_delta.png")
+    figures = {}
+    for (model, delta), (pk, rs) in TARGETS.items():
+        name = material_name(model, delta)
+        if name in env:
+            figures[f"envelope_phi_peak_{name}"] = common.figure(
+                env[name]["peak"]["phi"], pk, "deg", "slope of the peak envelope, "
+                f"apparent cohesion {env[name]['peak']['cohesion'] / 1e3:.1f} kPa")
+            figures[f"envelope_phi_residual_{name}"] = common.figure(
+                env[name]["residual"]["phi"], rs, "deg", "slope of the residual envelope")
+            figures[f"mean_phi_peak_{name}"] = common.figure(
+                float(np.mean(env[name]["phi_peak_tests"])), pk, "deg",
+                "mean of the tests at the three confining stresses")
+            figures[f"mean_phi_residual_{name}"] = common.figure(
+                float(np.mean(env[name]["phi_residual_tests"])), rs, "deg",
+                "mean of the tests at the three confining stresses")
+    names = ("none", "model2_delta0.4", "model1_delta0.4")
+    if all(n in env for n in names):
+        none, m2, m1 = (float(np.mean(env[n]["phi_peak_tests"])) for n in names)
+        figures["model2_between_none_and_model1"] = common.figure(
+            bool(none < m2 < m1), True, "",
+            f"mean peak phi at delta = 0.4: none {none:.2f}, Model 2 {m2:.2f}, "
+            f"Model 1 {m1:.2f} (the paper: 24.4, 26.5, 29.0; also 28.8 for Model 1 in "
+            "its §5.2)")
+    m1 = {r["task"]["delta"]: r for r in results if r["task"]["model"] == 1
+          or r["task"]["delta"] == 0.0}
+    summary = {
+        "case": CASE, "preset": args.preset, "mode": "sweep",
+        "paper": "Jiang, Yu & Harris (2005), Comput. Geotech. 32, §5, Figs. 12-13",
+        "figures": figures,
+        "envelopes": env,
+        "tests": [{"task": r["task"], "phi": r["phi"], "sigma_h_hold": r["hold"],
+                   "void_ratio": r["before"]["void_ratio"], "wall_s": r["wall_s"]}
+                  for r in results],
+        "model1_phi_peak_increases_with_delta": bool(np.all(np.diff(
+            [np.mean([r["phi"]["phi_peak"] for r in results if r["task"]["delta"] == d
+                      and r["task"]["model"] in (0, 1)]) for d in sorted(m1)]) > 0)),
+        "runtime_s": clock(),
+    }
+    common.write_summary(out, summary)
+    print(f"biaxial sweep: {len(results)} tests in {clock():.0f} s -> {out}")
+    return summary
+
+
+def main(argv=None):
+    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
+    from tdem.errors import InputError
+    clock = common.Stopwatch()
+    cfg = PRESETS[args.preset]
+    if not (args.confining > 0 and math.isfinite(args.confining)):
+        raise InputError(f"confining must be a positive stress in Pa, got {args.confining!r}")
+    if args.sweep:
+        return _main_sweep(args, out, cfg, clock)
+    if args.delta is not None or args.model is not None:
+        model = 1 if args.model is None else args.model
+        delta = 0.4 if args.delta is None else args.delta
+        if model == 0 or delta == 0.0:
+            model, delta = 0, 0.0
+        tests = [check_material(model, delta)]
+        envelope_confining = ()
+    else:
+        tests = list(cfg["tests"])
+        envelope_confining = cfg["envelope_confining"]
+    base = {"n": cfg["n"], "axial_strain": cfg["axial_strain"], "seed": SEED,
+            "threads": args.threads, "arch": args.arch}
+    results = []
+    specimen_dir = out / "specimens"
+    rate = strain_rate_at(cfg["strain_rate"], args.confining)
+    for model, delta in tests:
+        task = dict(base, confining=args.confining, model=model, delta=delta, strain_rate=rate)
+        name = material_name(model, delta)
+        r = run_test(task, output=out / "vtu" / name, vtu_snapshots=cfg["vtu_snapshots"],
+                     specimen_dir=specimen_dir)
+        results.append(r)
+        print(f"  {name} at {args.confining / 1e3:g} kPa: phi peak/residual = "
+              f"{r['phi']['phi_peak']:.1f}/{r['phi']['phi_residual']:.1f} deg, "
+              f"sigma_h held within {100 * r['hold']:.2f} %, {r['wall_s']:.0f} s", flush=True)
+    for s in envelope_confining:
+        for model, delta in MATERIALS:
+            task = dict(base, confining=s, model=model, delta=delta,
+                        strain_rate=strain_rate_at(cfg["strain_rate"], s))
+            results.append(run_test(task, specimen_dir=specimen_dir))
+    main_runs = [r for r in results if r["task"]["confining"] == args.confining]
+    plot_fig11(main_runs, out / "fig11_stress_strain.png", args.confining)
+    first = main_runs[0]
+    spec0 = specimen_for(first["task"], specimen_dir)
+    plot_specimen(spec0, out / "fig10_specimen.png",
+                  f"specimen before compression: {spec0.sim.n_particles} discs, "
+                  f"e = {spec0.void_ratio():.3f}\n{1e3 * spec0.width:.1f} x "
+                  f"{1e3 * spec0.height:.1f} mm, σ = {args.confining / 1e3:g} kPa")
+    if first["spec"] is not None:
+        common.plot_histories(first["spec"].sim, out / "monitors.png",
+                              title=f"{first['name']}: wall stresses and specimen size")
+    env = None
+    if envelope_confining:
+        env = envelopes(results)
+        plot_fig12(env, out / "fig12_envelopes.png")
+    save_results(out / "biaxial.h5", results, extra={"envelopes": env} if env else None)
+
+    g = spec0.grading
+    before = first["before"]
+    figures = _figures(results)
+    figures.update({
+        "void_ratio": common.figure(before["void_ratio"], 0.25, "",
+                                    "planar void ratio of the specimen under σ_h before "
+                                    "compression"),
+        "sigma_h_hold": common.figure(max(r["hold"] for r in results), "< 0.02", "fraction",
+                                      "largest deviation of σ_h from its target, averaged "
+                                      "over 0.5 % axial strain, over all tests"),
+        "width_mm": common.figure(1e3 * before["width"], 180.0, "mm",
+                                  "the size follows from the discs and the void ratio"),
+        "height_mm": common.figure(1e3 * before["height"], 306.7, "mm", ""),
+        "d50_mm": common.figure(1e3 * g["d50"], 7.6, "mm", "by area"),
+        "cu": common.figure(g["cu"], 1.3, "", "d60/d10 by area"),
+    })
+    if env:
+        for name, e in env.items():
+            key = {"none": (0, 0.0), "model1_delta0.4": (1, 0.4),
+                   "model2_delta0.4": (2, 0.4)}.get(name)
+            t = TARGETS.get(key, (None, None))
+            figures[f"envelope_phi_peak_{name}"] = common.figure(
+                e["peak"]["phi"], t[0], "deg",
+                f"peak envelope slope; apparent cohesion {e['peak']['cohesion'] / 1e3:.1f} kPa")
+            figures[f"envelope_phi_residual_{name}"] = common.figure(
+                e["residual"]["phi"], t[1], "deg", "residual envelope slope")
+    d50 = g["d50"]
+    summary = {
+        "case": CASE,
+        "preset": args.preset,
+        "paper": "Jiang, Yu & Harris (2005), Comput. Geotech. 32, §5, Figs. 10-13",
+        "figures": figures,
+        "tests": [{"name": r["name"], "confining": r["task"]["confining"], "phi": r["phi"],
+                   "sigma_h_hold": r["hold"], "steps": r["steps"], "wall_s": r["wall_s"]}
+                  for r in results],
+        "envelopes": env,
+        "specimen": {"state": before, "grading": g, "preparation": spec0.history},
+        "parameters": {
+            "n": cfg["n"], "kn": 2e8, "ks": 1.5e8, "friction": 0.5, "density": DENSITY,
+            "wall_friction": 0.0, "local_damping": 0.7, "strain_rate": rate,
+            "strain_rate_at_200kPa": cfg["strain_rate"], "axial_strain": cfg["axial_strain"],
+            "dt": spec0.sim.dt,
+            "inertial_number": rate * d50 * math.sqrt(DENSITY / args.confining),
+        },
+        "runtime_s": clock(),
+    }
+    common.write_summary(out, summary)
+    print(f"biaxial ({args.preset}): e = {before['void_ratio']:.4f}, "
+          + ", ".join(f"{r['name']} {r['phi']['phi_peak']:.1f}/{r['phi']['phi_residual']:.1f}°"
+                      for r in main_runs) + f"; {clock():.1f} s -> {out}")
+    return summary
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
