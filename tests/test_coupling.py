@@ -248,3 +248,29 @@ def test_point_edge_contacts_are_written_for_paraview(tmp_path):
     assert m.cell_data["normal_force"][0][0] == pytest.approx(w, rel=0.05)
     assert (tmp_path / "o" / "couplings.pvd").exists()
     assert (tmp_path / "o" / "blocks.pvd").exists()
+
+
+def test_cohesive_contact_sheared_caps_then_loses_its_cohesion():
+    v, t, _, _ = _rotated_block(0.0)
+    sim = tdem.Simulation(gravity=(0.0, -G), dt=2e-5)
+    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e8, 0.25))
+    block.fix(np.arange(len(v)), vx=0.0, vy=0.0)
+    r, C, phi = 0.05, 2e3, 30.0
+    disc = sim.add_particles([[0.03, r]], r, density=2000.0, contact=tdem.LinearContact(kn=1e7))
+    sim.couple(disc, block, tdem.PointEdge(kn=1e7, ks=1e7, friction_angle=phi,
+                                           cohesion=C, tensile_strength=1e4))
+    sim.fix_particles(disc.ids, vx=0.0, vy=0.0)
+    sim.run(steps=10)
+    sim.fix_particles(disc.ids, vx=0.0, vy=-0.001)      # press it in: F_n = K_n·δ
+    sim.run(steps=500)
+    fn = sim.particles.numpy()["force"][0, 1]
+    sim.fix_particles(disc.ids, vx=0.002, vy=0.0)       # then shear it
+    fs = []
+    for _ in range(300):
+        sim.run(steps=10)
+        fs.append(-sim.particles.numpy()["force"][0, 0])
+    fs = np.array(fs)
+    tan = math.tan(math.radians(phi))
+    assert fn > 0
+    assert fs.max() == pytest.approx(fn * tan + C * 2 * r, rel=0.01)
+    assert fs[-1] == pytest.approx(fn * tan, rel=0.01)
