@@ -343,6 +343,18 @@ def create_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(), tol: ti.f6
 
 
 @ti.func
+def _sorted3(v0, v1, v2):
+    """The three indices in increasing order."""
+    if v0 > v1:
+        v0, v1 = v1, v0
+    if v1 > v2:
+        v1, v2 = v2, v1
+    if v0 > v1:
+        v0, v1 = v1, v0
+    return v0, v1, v2
+
+
+@ti.func
 def _has(o, e1, e2, v):
     return o == v or e1 == v or e2 == v
 
@@ -356,15 +368,7 @@ def count_cover(pos: ti.types.ndarray(), nbr: ti.types.ndarray(), nbr_cnt: ti.ty
     n = pos.shape[0]
     for a in range(n):
         for s in range(ecnt[a]):
-            v0 = a
-            v1 = elem[a, s, 0]
-            v2 = elem[a, s, 1]
-            if v0 > v1:
-                v0, v1 = v1, v0
-            if v1 > v2:
-                v1, v2 = v2, v1
-            if v0 > v1:
-                v0, v1 = v1, v0
+            v0, v1, v2 = _sorted3(a, elem[a, s, 0], elem[a, s, 1])
             count = _cover(v0, v1, v2, pos, nbr, nbr_cnt, elem, ecnt)
             ncover[a, s] = count
         for s in range(ecnt[a], MAX_ELEMENTS):
@@ -849,13 +853,7 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
             if emult[a, s] > 0:
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
-                v0, v1, v2 = a, b, c
-                if v0 > v1:
-                    v0, v1 = v1, v0
-                if v1 > v2:
-                    v1, v2 = v2, v1
-                if v0 > v1:
-                    v0, v1 = v1, v0
+                v0, v1, v2 = _sorted3(a, b, c)
                 cover = _cover_incident(v0, v1, v2, pos, elem, inc, icnt, emult)
                 ncov[a, s] = cover
                 xa, xb, xc = pos[a], pos[b], pos[c]

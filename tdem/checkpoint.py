@@ -174,7 +174,6 @@ def load(path, arch=None):
 
     from physics.materials import Material
 
-    from .continuum import Continuum
     from .simulation import Block, ParticleGroup, Simulation
 
     with h5py.File(str(path), "r") as f:
@@ -246,14 +245,7 @@ def load(path, arch=None):
     sim._steps = cfg["steps"]
 
     if cfg["built"] and sim._slots:
-        if sim._n:
-            pos = np.concatenate(sim._host["pos"])
-            rad = np.concatenate(sim._host["radius"])
-            pmat = np.concatenate(sim._host["mat"]).astype(np.int64)
-        else:
-            pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
-        sim._cont = Continuum(pos, rad, pmat, sim._slots, sim._blocks,
-                              couples=sim._couple_rows())
+        sim._cont = sim._new_continuum()
         cap = cfg.get("continuum_capacity", 0)
         if cap > sim._cont.capacity:
             sim._cont.capacity = cap

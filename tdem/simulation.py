@@ -914,14 +914,7 @@ class Simulation:
         if self._n == 0 and not self._blocks:
             raise InputError("the simulation has no particles: call add_particles first")
         if self._slots:
-            if self._n:
-                pos = np.concatenate(self._host["pos"])
-                rad = np.concatenate(self._host["radius"])
-                pmat = np.concatenate(self._host["mat"]).astype(np.int64)
-            else:
-                pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
-            self._cont = Continuum(pos, rad, pmat, self._slots, self._blocks,
-                                   couples=self._couple_rows())
+            self._cont = self._new_continuum()
             for kind, ids, coef, block in self._nonreflect:
                 self._cont.set_non_reflecting(
                     kind, ids + block._offset if kind == "v" else ids, coef)
@@ -932,6 +925,16 @@ class Simulation:
             self._upload_params()
             return
         self._rebuild_from(self._fresh_state())
+
+    def _new_continuum(self):
+        """The continuum (PCMM elements, blocks, couples) of the particles as added."""
+        if self._n:
+            pos = np.concatenate(self._host["pos"])
+            rad = np.concatenate(self._host["radius"])
+            pmat = np.concatenate(self._host["mat"]).astype(np.int64)
+        else:
+            pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
+        return Continuum(pos, rad, pmat, self._slots, self._blocks, couples=self._couple_rows())
 
     def _require_built(self):
         if not self._built:
