@@ -257,3 +257,20 @@ def plot_models(models_xy, png, title=None):
 def rel(a, b):
     """|a - b| / |b| (None if b is 0)."""
     return abs(a - b) / abs(b) if b else None
+
+
+def finish(summary, out, hist, plot, watch):
+    """The end of a case's ``run``: histories, plots (``plot()``), run time, summary."""
+    common.save_histories(out / "histories.h5", hist)
+    plot()
+    summary["runtime_s"] = watch()
+    common.write_summary(out, summary)
+    return summary
+
+
+def main(case, run, doc, argv=None):
+    """Command line of a PCMM case: ``run`` with the parsed options, one summary line."""
+    args, out = common.parse(case, argv, description=doc.splitlines()[0])
+    s = run(args.preset, out, arch=args.arch, threads=args.threads)
+    print(f"summary: {out / 'summary.json'}; pass = {s['pass']}; {s['runtime_s']:.0f} s")
+    return 0

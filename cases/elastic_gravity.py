@@ -216,23 +216,16 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None):
                         "profile_sigma_yy": m.profile_syy, "monitor_uy": m.mon_uy,
                         "monitor_sigma_yy": m.mon_syy, **m.sim.histories()}
     summary["pass"] = bool(all_pass)
-    common.save_histories(out / "histories.h5", hist)
-    plots(runs, out)
-    summary["runtime_s"] = watch()
     summary["notes"] = ("PCMM element bodies span particle centre to centre (regular: "
                         "0.5-19.5 m), so they carry rho g (y_top_body - y); sigma_yy is "
                         "compared with the spec's -rho g (20 - y) for the pass flag.")
-    common.write_summary(out, summary)
-    return summary
+    return _pcmm.finish(summary, out, hist, lambda: plots(runs, out), watch)
 
 
 def plots(runs, out):
     plt = common.pyplot()
-    try:
-        _pcmm.plot_models(runs, out / "fig7_8_models.png",
-                          title="Models and initial PCMM element systems (paper Figs. 7-8)")
-    except Exception as e:  # a picture must not lose the results
-        print(f"note: model picture failed ({e})")
+    _pcmm.plot_models(runs, out / "fig7_8_models.png",
+                      title="Models and initial PCMM element systems (paper Figs. 7-8)")
     for key, fname, label, ana in (
             ("uy", "fig9_displacement.png", "vertical displacement (m)", uy_analytic),
             ("syy", "fig10_stress.png", "vertical stress σ_yy (Pa)", sigma_target)):
@@ -257,10 +250,7 @@ def plots(runs, out):
 
 
 def main(argv=None):
-    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
-    s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    print(f"summary: {out / 'summary.json'}; pass = {s['pass']}; {s['runtime_s']:.0f} s")
-    return 0
+    return _pcmm.main(CASE, run, __doc__, argv)
 
 
 if __name__ == "__main__":

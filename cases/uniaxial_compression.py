@@ -212,20 +212,13 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None):
                 "for information only: the same without the PCMM random model")
         all_pass &= ok
     summary["pass"] = bool(all_pass)
-    common.save_histories(out / "histories.h5", hist)
-    plots(runs, out, sc)
-    summary["runtime_s"] = watch()
-    common.write_summary(out, summary)
-    return summary
+    return _pcmm.finish(summary, out, hist, lambda: plots(runs, out, sc), watch)
 
 
 def plots(runs, out, sc):
     plt = common.pyplot()
-    try:
-        _pcmm.plot_models(runs, out / "fig11_12_models.png",
-                          title="Models and initial PCMM element systems (paper Figs. 11-12)")
-    except Exception as e:
-        print(f"note: model picture failed ({e})")
+    _pcmm.plot_models(runs, out / "fig11_12_models.png",
+                      title="Models and initial PCMM element systems (paper Figs. 11-12)")
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for m in runs:
         ax.plot(m.strain * 1e3, m.stress / 1e6, color=_pcmm.COLORS[m.name], lw=1.3,
@@ -241,10 +234,7 @@ def plots(runs, out, sc):
 
 
 def main(argv=None):
-    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
-    s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    print(f"summary: {out / 'summary.json'}; pass = {s['pass']}; {s['runtime_s']:.0f} s")
-    return 0
+    return _pcmm.main(CASE, run, __doc__, argv)
 
 
 if __name__ == "__main__":

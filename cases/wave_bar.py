@@ -177,20 +177,13 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None):
         }
         hist[m.name] = {"time": m.t, "vx": m.vx, "sigma_xx": m.sxx}
     summary["pass"] = bool(all_pass)
-    common.save_histories(out / "histories.h5", hist)
-    plots(runs, out, c_bar)
-    summary["runtime_s"] = watch()
-    common.write_summary(out, summary)
-    return summary
+    return _pcmm.finish(summary, out, hist, lambda: plots(runs, out, c_bar), watch)
 
 
 def plots(runs, out, c_bar):
     plt = common.pyplot()
-    try:
-        _pcmm.plot_models(runs, out / "fig14_models.png",
-                          title="Bar models, first 2 m (paper Fig. 14)")
-    except Exception as e:
-        print(f"note: model picture failed ({e})")
+    _pcmm.plot_models(runs, out / "fig14_models.png",
+                      title="Bar models, first 2 m (paper Fig. 14)")
     tt = np.linspace(0.0, T_END, 1001)
     for key, fname, label in (("vx", "fig15_velocity.png", "horizontal velocity (m/s)"),
                               ("sxx", "fig16_stress.png", "σ_xx (MPa)")):
@@ -214,10 +207,7 @@ def plots(runs, out, c_bar):
 
 
 def main(argv=None):
-    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
-    s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    print(f"summary: {out / 'summary.json'}; pass = {s['pass']}; {s['runtime_s']:.0f} s")
-    return 0
+    return _pcmm.main(CASE, run, __doc__, argv)
 
 
 if __name__ == "__main__":

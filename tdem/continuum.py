@@ -177,12 +177,15 @@ class Continuum:
         self.slots = slots
         self.blocks = blocks
         self.has_pcmm = bool((pmat >= 0).any())
+        # the longest Eq. 1 cut-off, 2·max R + max δ (the candidate search's reach)
+        self.reach_length = 2.0 * float(np.max(rad, initial=0.0)) + max(
+            (t for _, t in slots if t is not None), default=0.0)
         self.capacity = capacity
         self.masses = None
         self._crit = math.inf
         self._initial_elements(pos, rad, pmat)
         a = self.a = {}
-        n, cap, E = max(self.n, 1), self.capacity, pcmm.MAX_ELEMENTS
+        n, E = max(self.n, 1), pcmm.MAX_ELEMENTS
         nm = max(len(slots), 1)
         a["rad"] = ti.ndarray(ti.f64, (n,))
         a["pmat"] = ti.ndarray(ti.i32, (n,))

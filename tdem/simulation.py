@@ -731,17 +731,7 @@ class Simulation:
         if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
             raise InputError(f"ids must be particle indices in [0, {self._n}), got "
                              f"{ids.tolist()[:8]}")
-        vals = []
-        for name, v in (("vx", vx), ("vy", vy), ("omega", omega)):
-            if v is None or callable(v):
-                vals.append(v)
-                continue
-            a = np.broadcast_to(np.asarray(v, dtype=float), ids.shape).copy() \
-                if np.ndim(v) <= 1 and (np.ndim(v) == 0 or len(v) == len(ids)) else None
-            if a is None or not np.isfinite(a).all():
-                raise InputError(f"{name} must be None, a finite number, {len(ids)} numbers "
-                                 f"or a function of time, got {v!r}")
-            vals.append(a)
+        vals = [_fix_value(name, v, ids) for name, v in (("vx", vx), ("vy", vy), ("omega", omega))]
         self._fixes.append((ids, *vals))
         if self._built:
             self._apply_fixes(initial=True)
@@ -1125,9 +1115,7 @@ class Simulation:
         """Arguments of the step and rebuild kernels; the PCMM candidate search reach."""
         if self._cont is not None and self._cont.has_pcmm:
             h = float(self._a["gridp"].to_numpy()[2])
-            rmax = float(self._cont.a["rad"].to_numpy().max())
-            tmax = max((t for _, t in self._slots if t is not None), default=0.0)
-            self._reach = max(1, int(math.ceil((2 * rmax + tmax + 2 * self.skin) / h)))
+            self._reach = max(1, int(math.ceil((self._cont.reach_length + 2 * self.skin) / h)))
         else:
             self._reach = 1
         if self._n == 0:
