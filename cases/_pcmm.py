@@ -5,11 +5,13 @@ selections, read-outs at monitoring points, the run loop and common plots.
 
 A model is described by a small dict ``spec``:
 
-- ``{"kind": "regular" | "cross", "radius": R, "tolerance": δ, "inset": None | 0}``
-  (a square or hexagonal lattice built from R by ``tdem.pack``; ``inset`` None puts
-  the outermost centres R from the edges, 0 puts them on the edges);
-- ``{"kind": "random", "rmin": .., "rmax": .., "tolerance": δ, "fraction": 0.8}``
-  (``tdem.pack.random``, seed 0);
+- ``{"kind": "regular" | "cross", "radius": R, "tolerance": δ, "inset": None | 0,
+  "fit": False}`` (a square or hexagonal lattice built from R by ``tdem.pack``;
+  ``inset`` None puts the outermost centres R from the edges, 0 puts them on the
+  edges; cross ``fit`` True shrinks the spacings so that the rows end on the edges);
+- ``{"kind": "random", "rmin": .., "rmax": .., "tolerance": δ, "fraction": 0.8,
+  "edge_centres": False}`` (``tdem.pack.random``, seed 0; ``edge_centres`` True
+  puts the boundary discs' centres on the edges);
 - ``{"kind": "fvm", "cells": (nx, ny), "pattern": "regular" | "cross"}``
   (``tdem.mesh.rectangle`` block).
 """
@@ -61,14 +63,15 @@ class Model:
                                            inset=spec.get("inset"))
             elif kind == "cross":
                 pos, r = tdem.pack.cross(W, H, spec["radius"], origin=origin,
-                                         inset=spec.get("inset"))
+                                         inset=spec.get("inset"), fit=spec.get("fit", False))
             elif kind == "random":
                 frac = spec.get("fraction", 0.8)
                 while True:   # lower the fraction by 0.02 until the packer succeeds
                     try:
                         pos, r = tdem.pack.random(W, H, spec["rmin"], spec["rmax"],
                                                   seed=spec.get("seed", 0),
-                                                  target_fraction=frac, origin=origin)
+                                                  target_fraction=frac, origin=origin,
+                                                  edge_centres=spec.get("edge_centres", False))
                         break
                     except tdem.InputError:
                         if frac <= 0.6:

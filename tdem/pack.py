@@ -75,17 +75,28 @@ def regular(width, height, radius, origin=(0.0, 0.0), inset=None):
     return pos, np.full(len(pos), r)
 
 
-def cross(width, height, radius, origin=(0.0, 0.0), inset=None):
+def cross(width, height, radius, origin=(0.0, 0.0), inset=None, fit=False):
     """Hexagonal lattice of touching discs of radius R.
 
     Rows run along x, R·√3 apart in y; in-row spacing 2R; odd rows are shifted by
     R. Centres lie in ``origin + [0, width] × [0, height]`` at least ``inset``
     (default R) from its edges; ordered row by row (x fastest). Each interior
     disc touches six others at 60° intervals.
+
+    ``fit=True`` shrinks the two spacings to the span of the centres divided by
+    the smallest whole number of spacings that covers it (row spacing ≤ R·√3,
+    in-row spacing ≤ 2R), so that the first and last rows and the ends of the
+    even rows lie on the span's edges; odd rows hold one centre less, at the
+    midpoints of the even row's spacings. The discs then overlap slightly (every
+    neighbour distance ≤ 2R). With ``inset=0`` this is the node layout of a
+    structured cross-triangle mesh: 20 × 20 m with R = √3/3 m gives 21 rows of
+    19 and 18 centres, 389 discs (Feng, Li & Oñate 2015, §3.1).
     """
     w, h, r, inset = _lattice_span(width, height, radius, inset)
     o = _origin(origin)
     dy = r * math.sqrt(3.0)
+    if fit:
+        return _cross_fit(w, h, r, inset, o, dy)
     rows = []
     for k in range(_count(h, dy)):
         shift = r * (k % 2)
@@ -94,6 +105,28 @@ def cross(width, height, radius, origin=(0.0, 0.0), inset=None):
         n = _count(w - shift, 2 * r)
         x = o[0] + inset + shift + 2 * r * np.arange(n)
         rows.append(np.stack([x, np.full(n, o[1] + inset + k * dy)], axis=1))
+    pos = np.concatenate(rows)
+    return pos, np.full(len(pos), r)
+
+
+def _segments(length, spacing):
+    """The smallest whole number (>= 1) of spacings of at most ``spacing`` that span
+    ``length``."""
+    return max(1, int(math.ceil(length / spacing * (1 - _FIT_EPS) - _FIT_EPS)))
+
+
+def _cross_fit(w, h, r, inset, o, dy):
+    ny = _segments(h, dy) if h > 0 else 0
+    nx = _segments(w, 2 * r) if w > 0 else 0
+    sy = h / ny if ny else 0.0
+    sx = w / nx if nx else 0.0
+    rows = []
+    for k in range(ny + 1):
+        if k % 2 == 0 or nx == 0:
+            x = o[0] + inset + sx * np.arange(nx + 1)
+        else:
+            x = o[0] + inset + sx * (0.5 + np.arange(nx))
+        rows.append(np.stack([x, np.full(len(x), o[1] + inset + k * sy)], axis=1))
     pos = np.concatenate(rows)
     return pos, np.full(len(pos), r)
 
@@ -194,7 +227,7 @@ def _pairs(x, cut, h):
 
 
 def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 0.0),
-           polygon=None, overlap_tol=1e-3, max_iter=20000):
+           polygon=None, overlap_tol=1e-3, max_iter=20000, edge_centres=False):
     """Dense random packing of discs with radii uniform in [rmin, rmax].
 
     The region is the rectangle ``origin + [0, width] × [0, height]``, or the
@@ -215,6 +248,16 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     jam at about 0.825, walls included), and a fraction that cannot be reached
     raises :class:`tdem.InputError` after ``max_iter`` sweeps. That square at 0.8
     holds about 1710 discs and takes a few seconds.
+
+    ``edge_centres=True`` first lines the boundary with discs whose centres lie on
+    it, as the boundary nodes of a mesh: a disc on every vertex, and along each
+    edge discs with radii drawn from the same range, as many as fit in a row of
+    touching discs, then spread evenly to the edge's length (gaps below 2·rmax
+    divided by their number). These discs stay where they are (they are listed
+    first); the others are packed inside the region as above and kept clear of
+    them. The area fraction then counts the part of each boundary disc inside the
+    region (half a disc on an edge, the corner's angle on a vertex). Default off:
+    the packing and its random stream are unchanged.
     """
     rmin = _positive("rmin", rmin)
     rmax = _positive("rmax", rmax)
@@ -232,13 +275,23 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
                          f"for discs of rmax={rmax!r}")
     rng = np.random.default_rng(seed)
 
+    if edge_centres:
+        xb, rb, inside_area = _edge_discs(poly, rmin, rmax, rng)
+    else:
+        xb, rb, inside_area = np.zeros((0, 2)), np.zeros(0), 0.0
+    nb = len(xb)
+    target_area = tf * area - inside_area
+    if target_area <= 0.0:
+        raise InputError(f"the boundary discs alone cover more than target_fraction="
+                         f"{target_fraction!r} of the region")
+
     # radii until the target area is reached
     mean_area = math.pi * (rmin * rmin + rmin * rmax + rmax * rmax) / 3.0
-    est = int(tf * area / mean_area * 1.1) + 16
+    est = int(target_area / mean_area * 1.1) + 16
     r = rng.uniform(rmin, rmax, est)
-    while np.sum(np.pi * r * r) < tf * area:
+    while np.sum(np.pi * r * r) < target_area:
         r = np.concatenate([r, rng.uniform(rmin, rmax, est)])
-    n = int(np.searchsorted(np.cumsum(np.pi * r * r), tf * area)) + 1
+    n = int(np.searchsorted(np.cumsum(np.pi * r * r), target_area)) + 1
     r = r[:n]
 
     # centres uniform in the region (rejection from the bounding box)
@@ -248,6 +301,11 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
         sd, _ = _signed_distance(cand, poly)
         x = np.concatenate([x, cand[sd > 0]])
     x = x[:n]
+    if nb:
+        x = np.concatenate([xb, x])
+        r = np.concatenate([rb, r])
+        n = len(r)
+    free = np.arange(n) >= nb           # the boundary discs do not move
 
     tol = overlap_tol * rmin
     skin = 0.5 * rmin
@@ -259,9 +317,14 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     for _ in range(int(max_iter)):
         if x_ref is None or np.max(np.sum((x - x_ref) ** 2, axis=1)) > (0.5 * skin) ** 2:
             i, j = _pairs(x, 2 * rmax + skin, h)
-            near_edge = np.nonzero(_signed_distance(x, poly)[0] < rmax + skin)[0]
+            if nb:
+                both = ~free[i] & ~free[j]
+                i, j = i[~both], j[~both]
+            near_edge = np.nonzero((_signed_distance(x, poly)[0] < rmax + skin) & free)[0]
             x_ref = x.copy()
         rs = scale * r
+        if nb:
+            rs[:nb] = r[:nb]
         d = x[j] - x[i]
         dist = np.sqrt(np.einsum("nk,nk->n", d, d))
         ov = rs[i] + rs[j] - dist
@@ -270,10 +333,13 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
         worst = 0.0
         if hit.any():
             worst = float(ov[hit].max())
-            s = (0.5 * ov[hit] / np.maximum(dist[hit], 1e-300))[:, None] * d[hit]
+            # half the overlap to each disc; all of it to a free disc against a fixed one
+            share = np.where(free[i[hit]] & free[j[hit]], 0.5, 1.0)
+            s = (share * ov[hit] / np.maximum(dist[hit], 1e-300))[:, None] * d[hit]
             for k in range(2):
                 push[:, k] += np.bincount(j[hit], s[:, k], minlength=n) - np.bincount(
                     i[hit], s[:, k], minlength=n)
+            push[~free] = 0.0
         if len(near_edge):
             sd, inward = _signed_distance(x[near_edge], poly)
             pen = rs[near_edge] - sd
@@ -292,3 +358,44 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     raise InputError(f"target_fraction={target_fraction!r} could not be reached without "
                      f"overlaps in {max_iter} sweeps (largest overlap {worst:.3g} m); "
                      f"lower it")
+
+
+def _edge_discs(poly, rmin, rmax, rng):
+    """Discs centred on the boundary of ``poly``: one on each vertex, and along each
+    edge as many as fit in a row of touching discs between the two vertex discs,
+    spread evenly to the edge's length. Returns (centres, radii, the discs' area
+    inside the polygon)."""
+    m = len(poly)
+    rv = rng.uniform(rmin, rmax, m)
+    xs, rs = [], []
+    inside = 0.0
+    for k in range(m):
+        a, b = poly[k], poly[(k + 1) % m]
+        e_in, e_out = poly[k - 1] - a, b - a
+        ang = math.atan2(e_in[0] * e_out[1] - e_in[1] * e_out[0], float(e_in @ e_out))
+        ang = ang if ang > 0 else ang + 2 * math.pi       # interior angle at vertex a
+        inside += 0.5 * ang * rv[k] ** 2
+        xs.append(a[None])
+        rs.append(rv[k:k + 1])
+        length = float(np.linalg.norm(b - a))
+        r_end = rv[(k + 1) % m]
+        ri = []
+        span = rv[k] + r_end
+        while True:
+            new = rng.uniform(rmin, rmax)
+            if span + 2 * new > length:
+                break
+            ri.append(new)
+            span += 2 * new
+        if span > length:
+            raise InputError(f"a polygon edge of length {length:.3g} m is too short for "
+                             f"discs centred on both its ends")
+        if ri:
+            ri = np.asarray(ri)
+            # centre distances from a: r_a + r_1, then r_i + r_{i+1}, spread to the length
+            t = rv[k] + np.cumsum(np.concatenate([[0.0], ri[:-1] + ri[1:]])) + ri[0]
+            t = t * (length / span)
+            xs.append(a + t[:, None] * (b - a) / length)
+            rs.append(ri)
+            inside += 0.5 * math.pi * float(np.sum(ri * ri))
+    return np.concatenate(xs), np.concatenate(rs), inside

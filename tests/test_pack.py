@@ -126,3 +126,43 @@ def test_bad_input_names_the_argument(call, word):
 def test_unreachable_fraction_raises():
     with pytest.raises(tdem.InputError, match="target_fraction"):
         pack.random(1.0, 1.0, 0.1, 0.12, target_fraction=0.85, max_iter=300)
+
+
+def test_cross_fit_puts_the_rows_on_the_edges():
+    """fit=True: the paper's 389-particle cross model of the 20 x 20 m square."""
+    R = math.sqrt(3.0) / 3.0
+    x, r = pack.cross(20.0, 20.0, R, inset=0.0, fit=True)
+    assert len(x) == 389 and np.all(r == R)                     # 11 x 19 + 10 x 18
+    assert x.min(axis=0) == pytest.approx([0.0, 0.0], abs=1e-12)
+    assert x.max(axis=0) == pytest.approx([20.0, 20.0])
+    np.testing.assert_allclose(np.unique(np.round(x[:, 1], 9)), np.arange(21.0), atol=1e-9)
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    np.fill_diagonal(d, np.inf)
+    nearest = d.min(axis=1)
+    assert nearest.max() <= 2 * R and nearest.min() == pytest.approx(20.0 / 18.0)
+    # the default lattice is unchanged
+    assert len(pack.cross(20.0, 20.0, R, inset=0.0)[0]) == 368
+
+
+def test_random_edge_centres():
+    W = H = 20.0
+    x, r = pack.random(W, H, 0.336, 0.624, seed=0, edge_centres=True)
+    on = (np.isclose(x[:, 0], 0.0) | np.isclose(x[:, 0], W)
+          | np.isclose(x[:, 1], 0.0) | np.isclose(x[:, 1], H))
+    nb = int(on.sum())
+    assert nb > 0 and np.all(on[:nb]) and not on[nb:].any()    # boundary discs first
+    for corner in ([0, 0], [W, 0], [W, H], [0, H]):
+        assert np.any(np.all(np.isclose(x, corner), axis=1))
+    assert np.all((r >= 0.336) & (r <= 0.624))
+    # free discs inside, no overlap beyond the tolerance; boundary discs spread with
+    # gaps below 2 rmax / (their number on an edge)
+    assert np.all((x[nb:] - r[nb:, None] >= -1e-3 * 0.336) &
+                  (x[nb:] + r[nb:, None] <= W + 1e-3 * 0.336))
+    assert _min_gap(x, r) >= -1e-3 * 0.336
+    d = np.linalg.norm(x[:nb, None] - x[None, :nb], axis=2) - r[:nb, None] - r[None, :nb]
+    np.fill_diagonal(d, np.inf)
+    assert d.min(axis=1).max() <= 0.1
+    inside = np.sum(np.pi * r[nb:] ** 2) + 0.5 * np.pi * np.sum(r[:nb] ** 2)
+    assert inside / (W * H) == pytest.approx(0.8, abs=0.02)
+    x2, r2 = pack.random(W, H, 0.336, 0.624, seed=0, edge_centres=True)
+    np.testing.assert_array_equal(x, x2)

@@ -1,14 +1,17 @@
 """The PCMM precision cases (Feng, Li & Oñate 2015 §3) against their targets.
 
 The default run checks the FVM block model and the regular and hexagonal ("cross")
-PCMM lattices; the random packings (slower to build and to run) are in the slow
-tests. Targets and tolerances are those of the case docstrings (CASES.md).
+PCMM lattices (elastic_gravity: all four models); the random packings (slower to
+build and to run) of the other cases are in the slow tests. Targets and tolerances
+are those of the case docstrings (CASES.md).
 """
 import math
 
 import pytest
 
-from cases import uniaxial_compression, wave_bar
+import numpy as np
+
+from cases import elastic_gravity, uniaxial_compression, wave_bar
 
 
 @pytest.fixture(scope="module")
@@ -61,3 +64,54 @@ def test_wave_bar_random_model(tmp_path):
     m = s["models"]["random"]
     assert m["peak_velocity_pass"]
     assert m["arrival_pass"] and m["peak_stress_pass"]
+
+
+@pytest.fixture(scope="module")
+def gravity(tmp_path_factory):
+    return elastic_gravity.run("quick", out=tmp_path_factory.mktemp("gravity"))
+
+
+@pytest.mark.parametrize("model", ["regular", "cross", "random"])
+def test_elastic_gravity_displacement_profiles_agree_with_fvm(gravity, model):
+    m = gravity["models"][model]
+    assert m["converged"]
+    # every body spans 0-20 m, carries its weight and is held by its base
+    assert m["element_body_y"] == pytest.approx([0.0, 20.0])
+    assert m["weight_rel_to_rho_g_element_area"] == pytest.approx(1.0, abs=0.005)
+    assert m["support_N"] == pytest.approx(m["weight_N"], rel=1e-3)
+    assert m["uy_profile_deviation_from_fvm"]["value"] <= 0.05
+
+
+def test_elastic_gravity_fvm_matches_the_elastic_solution(gravity):
+    m = gravity["models"]["fvm"]
+    assert m["converged"]
+    assert m["weight_N"] == pytest.approx(2000.0 * 9.81 * 400.0)
+    assert m["uy_max_rel_diff_from_elastic_reference"] <= 0.01
+    assert np.max(np.abs(m["sigma_yy_rel_diff_from_elastic_reference"]["value"])) <= 0.01
+
+
+@pytest.mark.parametrize("model, tol", [("regular", 0.01), ("cross", 0.01), ("random", 0.10)])
+def test_elastic_gravity_pcmm_stress_follows_the_elastic_solution(gravity, model, tol):
+    """Regular and cross lattices within 1 % (of rho g (H - y)) of the elastic
+    solution at every monitor; the coarse random packing within 10 % (measured 8.4 %
+    at y = 16 m: its fit over scattered particles is noisier)."""
+    m = gravity["models"][model]
+    diff = np.asarray(m["sigma_yy_rel_diff_from_elastic_reference"]["value"])
+    away = np.asarray(gravity["monitor_y"]) >= elastic_gravity.BASE_Y
+    assert np.max(np.abs(diff[away])) <= tol
+
+
+_EXACT = ("the plane-strain elastic solution of the fixed-base 20 x 20 m square is "
+          "5.5-5.9 % above rho g (H - y) at (10, 8-12) m (summary 'elastic_reference'); "
+          "this model reproduces it within 1 %, so it misses 5 % there by < 1 %")
+
+
+@pytest.mark.parametrize("model", [
+    pytest.param("fvm", marks=pytest.mark.xfail(reason=_EXACT, strict=True)),
+    pytest.param("regular", marks=pytest.mark.xfail(reason=_EXACT, strict=True)),
+    pytest.param("cross", marks=pytest.mark.xfail(reason=_EXACT, strict=True)),
+    "random"])
+def test_elastic_gravity_sigma_yy_within_5_percent_of_rho_g_depth(gravity, model):
+    """The issue's stress target: within 5 % of -rho g (H - y) at y >= 4 m."""
+    m = gravity["models"][model]
+    assert m["sigma_yy_max_rel_error_away_from_base"]["value"] <= 0.05
