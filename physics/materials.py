@@ -76,7 +76,7 @@ Every material packs into one row of ``MAT_WIDTH`` floats so that kernels can re
 any material from one 2D array ``matp[M, col]``:
 
 ====  ==============================================================
-0     type: 0 Elastic, 1 Mohr–Coulomb, 2 Fluid
+0     type: 0 Elastic, 1 Mohr–Coulomb, 2 Fluid, 3 JWL
 1     density ρ (kg/m³)
 2     bulk modulus K (Pa)
 3     shear modulus G (Pa) (0 for a Fluid)
@@ -88,18 +88,31 @@ any material from one 2D array ``matp[M, col]``:
 9     residual cohesion c_r (Pa)               (used after first failure if brittle)
 10    residual tension T_r in use, capped (Pa)
 11    dynamic viscosity μ (Pa·s)              (Fluid, else 0)
+12    linear artificial bulk viscosity b1      (Fluid, JWL; else 0)
+13    quadratic artificial bulk viscosity b2   (Fluid, JWL; else 0)
 ====  ==============================================================
+
+A JWL row uses columns 4–10 for A, B, R1, R2, ω, E0 (Pa) and D (m/s); its column 2
+is ρ0·D², so that the signal speed sqrt(K/ρ0) the time step uses is the detonation
+speed.
+
+Artificial bulk viscosity (von Neumann–Richtmyer with a linear term, as in
+hydrocodes): an element whose area shrinks (Δθ < 0) adds the pressure
+q = ρ L |θ̇| (b1 c + b2 L |θ̇|), L = sqrt(S), c = sqrt((K + 4G/3)/ρ), to the stress
+of its nodal forces for that step (not to the stress it keeps). It spreads a shock
+over a few elements instead of letting it ring.
 """
 import math
 
+import numpy as np
 import taichi as ti
 
 from tdem.errors import InputError
 
 from .validate import in_range, non_negative, positive
 
-MAT_WIDTH = 12
-ELASTIC, MOHR_COULOMB, FLUID = 0, 1, 2
+MAT_WIDTH = 14
+ELASTIC, MOHR_COULOMB, FLUID, JWL_TYPE = 0, 1, 2, 3
 NO_FAILURE, SHEAR_FAILURE, TENSION_FAILURE = 0, 1, 2
 
 
@@ -147,7 +160,8 @@ class Material:
     def from_dict(d):
         d = dict(d)
         kind = d.pop("type", None)
-        classes = {"Elastic": Elastic, "MohrCoulomb": MohrCoulomb, "Fluid": Fluid}
+        classes = {"Elastic": Elastic, "MohrCoulomb": MohrCoulomb, "Fluid": Fluid,
+                   "JWL": JWL}
         if kind not in classes:
             raise InputError(f"type must be one of {sorted(classes)}, got {kind!r}")
         return classes[kind](**d)
@@ -182,7 +196,7 @@ class Elastic(Material):
 
     def row(self):
         return [float(ELASTIC), self.density, self.bulk, self.shear,
-                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0]
+                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
 
 
 class MohrCoulomb(Material):
@@ -256,7 +270,7 @@ class MohrCoulomb(Material):
         return [float(MOHR_COULOMB), self.density, self.bulk, self.shear,
                 self.cohesion, self.tension, self.n_phi, self.n_psi,
                 1.0 if self.brittle else 0.0, self.residual_cohesion,
-                self.residual_tension, 0.0]
+                self.residual_tension, 0.0, 0.0, 0.0]
 
 
 class Fluid(Material):
@@ -268,20 +282,106 @@ class Fluid(Material):
     bulk_modulus : K (Pa), > 0 (the paper: 2 GPa; a case may lower it, see §3)
     viscosity : dynamic viscosity μ (Pa·s), ≥ 0 (its stress is handled by the
         element update, not by ``mc_correct``, which leaves the stress unchanged)
+    linear_viscosity, quadratic_viscosity : artificial bulk viscosity b1, b2 ≥ 0
+        (module docstring; 0 = off)
     """
 
-    _ARGS = ("density", "bulk_modulus", "viscosity")
+    _ARGS = ("density", "bulk_modulus", "viscosity", "linear_viscosity",
+             "quadratic_viscosity")
 
-    def __init__(self, density=1000.0, bulk_modulus=2e9, viscosity=0.0):
+    def __init__(self, density=1000.0, bulk_modulus=2e9, viscosity=0.0,
+                 linear_viscosity=0.0, quadratic_viscosity=0.0):
         self.density = positive("density", density)
         self.bulk_modulus = positive("bulk_modulus", bulk_modulus)
         self.viscosity = non_negative("viscosity", viscosity)
+        self.linear_viscosity = non_negative("linear_viscosity", linear_viscosity)
+        self.quadratic_viscosity = non_negative("quadratic_viscosity", quadratic_viscosity)
         self.bulk = self.bulk_modulus
         self.shear = 0.0
 
     def row(self):
         return [float(FLUID), self.density, self.bulk, 0.0,
-                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, self.viscosity]
+                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, self.viscosity,
+                self.linear_viscosity, self.quadratic_viscosity]
+
+
+class JWL(Material):
+    """Detonation products of a high explosive, Jones–Wilkins–Lee (Feng et al. Eq. 25):
+
+        p = A (1 − ω/(R1 V)) e^(−R1 V) + B (1 − ω/(R2 V)) e^(−R2 V) + ω E/V,
+
+    V = ρ0/ρ the relative volume and E the internal energy per unit initial volume
+    (Pa), both tracked per particle (:func:`physics.pcmm.update`): V from the volume
+    changes of its elements, dE = −(p + q) dV with q the artificial bulk viscosity.
+    G = 0: a particle's stress is −p·I.
+
+    Programmed burn: :meth:`tdem.Simulation.detonate` gives each particle its
+    lighting time t_l = t0 + |x − x_det|/D; its pressure is F·p with the burn
+    fraction F = min(1, (t − t_l)·D/(3R)) for t ≥ t_l (0 before: the front crosses
+    one particle diameter and a half), R the particle radius.
+
+    Parameters
+    ----------
+    A, B : Pa, > 0;  R1, R2 : > 0;  omega : ω > 0;  E0 : initial internal energy per
+    unit volume (Pa), > 0;  density : ρ0 (kg/m³), > 0;  D : detonation speed (m/s), > 0
+    linear_viscosity, quadratic_viscosity : artificial bulk viscosity b1, b2 ≥ 0
+        (module docstring), default 0.06 and 1.5 (the usual hydrocode values)
+
+    The time step uses D as the signal speed (the column K = ρ0 D²), and the
+    default contact stiffness of its particles (contact law against other bodies)
+    is ρ0 D².
+    """
+
+    _ARGS = ("A", "B", "R1", "R2", "omega", "E0", "density", "D", "linear_viscosity",
+             "quadratic_viscosity")
+
+    def __init__(self, A, B, R1, R2, omega, E0, density, D, linear_viscosity=0.06,
+                 quadratic_viscosity=1.5):
+        self.A = positive("A", A)
+        self.B = positive("B", B)
+        self.R1 = positive("R1", R1)
+        self.R2 = positive("R2", R2)
+        self.omega = positive("omega", omega)
+        self.E0 = positive("E0", E0)
+        self.density = positive("density", density)
+        self.D = positive("D", D)
+        self.linear_viscosity = non_negative("linear_viscosity", linear_viscosity)
+        self.quadratic_viscosity = non_negative("quadratic_viscosity", quadratic_viscosity)
+        self.bulk = self.density * self.D ** 2
+        self.shear = 0.0
+        self.young = self.bulk
+
+    @classmethod
+    def tnt(cls, **kw):
+        """TNT: A = 371.2 GPa, B = 3.2 GPa, R1 = 4.2, R2 = 0.95, ω = 0.3 (Feng et al.);
+        ρ0 = 1630 kg/m³, E0 = 7.0 GPa, D = 6930 m/s (the standard values the paper
+        leaves out). Keyword arguments override any of them."""
+        args = dict(A=371.2e9, B=3.2e9, R1=4.2, R2=0.95, omega=0.3, E0=7.0e9,
+                    density=1630.0, D=6930.0)
+        args.update(kw)
+        return cls(**args)
+
+    def pressure(self, V, E):
+        """Eq. 25 at relative volume V and internal energy E per unit initial volume."""
+        V = np.asarray(V, dtype=float)
+        E = np.asarray(E, dtype=float)
+        p = (self.A * (1.0 - self.omega / (self.R1 * V)) * np.exp(-self.R1 * V)
+             + self.B * (1.0 - self.omega / (self.R2 * V)) * np.exp(-self.R2 * V)
+             + self.omega * E / V)
+        return p if p.ndim else float(p)
+
+    def row(self):
+        return [float(JWL_TYPE), self.density, self.bulk, 0.0,
+                self.A, self.B, self.R1, self.R2, self.omega, self.E0, self.D, 0.0,
+                self.linear_viscosity, self.quadratic_viscosity]
+
+
+@ti.func
+def jwl_pressure(matp: ti.template(), M, V, E):
+    """Eq. 25 of the JWL row M at relative volume V and energy E (per initial volume)."""
+    A, B, R1, R2, w = matp[M, 4], matp[M, 5], matp[M, 6], matp[M, 7], matp[M, 8]
+    return (A * (1.0 - w / (R1 * V)) * ti.exp(-R1 * V)
+            + B * (1.0 - w / (R2 * V)) * ti.exp(-R2 * V) + w * E / V)
 
 
 # ------------------------------------------------------------------ kernel side

@@ -70,7 +70,7 @@ from tdem import backend
 from tdem.errors import CapacityError, InputError
 
 from . import fvm
-from .materials import mc_correct_state
+from .materials import JWL_TYPE, jwl_pressure, mc_correct_state
 from .validate import positive
 
 MAX_ELEMENTS = 12        # elements a particle can create (pruned gaps are >= 30 deg)
@@ -758,8 +758,8 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
            encnt: ti.types.ndarray(), cskip: ti.types.ndarray(), inc: ti.types.ndarray(),
            icnt: ti.types.ndarray(), emult: ti.types.ndarray(), pflags: ti.types.ndarray(),
            elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
-           ecnt_old: ti.types.ndarray(), dt: ti.f64, carry: ti.template(),
-           serial: ti.template()):
+           ecnt_old: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
+           time: ti.f64, carry: ti.template(), jwl: ti.template(), serial: ti.template()):
     """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16), for the particles of x_n
     moving at v_{n−1/2}:
 
@@ -862,32 +862,96 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
                 de = fvm.strain_increment(grad, dt)
                 M = pmat[a]
+                kind = ti.cast(matp[M, 0], ti.i32)
+                # area on the mid-step configuration: Δθ·area is then exactly the
+                # area change of the step (the area is quadratic in the positions)
+                ea = (xb - h * vb) - (xa - h * va)
+                eb = (xc - h * vc) - (xa - h * va)
+                area = 0.5 * (ea[0] * eb[1] - ea[1] * eb[0])
                 sig = (psig[a] + psig[b] + psig[c]) / 3.0
-                if ti.static(carry):
-                    # an element that existed last step continues from its own stress
-                    found = False
-                    for t in ti.static(range(3)):
-                        o, u, w = a, b, c
-                        if ti.static(t == 1):
-                            o, u, w = b, c, a
-                        if ti.static(t == 2):
-                            o, u, w = c, a, b
-                        if not found:
-                            for so in range(ecnt_old[o]):
-                                if elem_old[o, so, 0] == u and elem_old[o, so, 1] == w:
-                                    sig = esig_old[o, so]
-                                    found = True
-                sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
-                    de, matp[M, 2], matp[M, 3])
-                failed = 0
-                if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
-                    failed = 1
-                sig, eps, flag = mc_correct_state(sig, matp, M, failed)
+                eps = 0.0
+                flag = 0
+                if kind != JWL_TYPE:
+                    # (a JWL element takes the mean of its particles' pressures: the
+                    # particles carry the equation of state, see the gather below)
+                    if ti.static(carry):
+                        # an element that existed last step continues from its own stress
+                        found = False
+                        for t in ti.static(range(3)):
+                            o, u, w = a, b, c
+                            if ti.static(t == 1):
+                                o, u, w = b, c, a
+                            if ti.static(t == 2):
+                                o, u, w = c, a, b
+                            if not found:
+                                for so in range(ecnt_old[o]):
+                                    if elem_old[o, so, 0] == u and elem_old[o, so, 1] == w:
+                                        sig = esig_old[o, so]
+                                        found = True
+                    sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+                        de, matp[M, 2], matp[M, 3])
+                    failed = 0
+                    if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
+                        failed = 1
+                    sig, eps, flag = mc_correct_state(sig, matp, M, failed)
                 esig[a, s] = sig
-                ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64)])
-                sf = sig + viscous_stress(matp, M, de, dt)
-                fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
-                efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+                q = bulk_viscosity(matp, M, de, dt, area)
+                ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64),
+                                       area / cover, q * (de[0] + de[1])])
+                if kind != JWL_TYPE:
+                    sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
+                    fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
+                    efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+    if ti.static(jwl):
+        # 2j. JWL particles: the equation of state at x_n. A particle's volume changes
+        #     by a third of Σ_e (S_e/N_e) Δθ_e over its elements (so that Σ_i p_i ΔVol_i
+        #     is the elements' pressure work exactly), its energy by −(p + q) ΔVol with
+        #     the p its elements pushed with over that change (last step's, so that the
+        #     energy lost is exactly the work the forces did); p = F·p_JWL(V, E) with F
+        #     the programmed burn fraction.
+        ti.loop_config(serialize=serial)
+        for i in range(n):
+            M = pmat[i]
+            if M >= 0:
+                if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                    thsum = 0.0
+                    qsum = 0.0
+                    for k in range(icnt[i]):
+                        code = inc[i, k]
+                        o = code >> 4
+                        sl = code & 15
+                        d = ede[o, sl]
+                        mw = ti.cast(emult[o, sl], ti.f64)
+                        thsum += mw * d[5] * (d[0] + d[1])
+                        qsum += mw * d[5] * d[6]
+                    js = pjwl[i]
+                    F = 0.0
+                    if time >= js[2]:
+                        F = ti.min(1.0, (time - js[2]) * matp[M, 10] / (3.0 * rad[i]))
+                    V0 = js[4]
+                    V = js[0] + thsum / (3.0 * V0)
+                    E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
+                    p = F * jwl_pressure(matp, M, V, E)
+                    pjwl[i] = ti.Vector([V, E, js[2], p, V0])
+        # 2k. JWL elements: the mean pressure of their particles, and q
+        ti.loop_config(serialize=serial)
+        for a in range(n):
+            for s in range(ecnt[a]):
+                if emult[a, s] > 0:
+                    M = pmat[a]
+                    if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                        b = elem[a, s, 0]
+                        c = elem[a, s, 1]
+                        pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
+                        sig = ti.Vector([-pm, -pm, 0.0, -pm])
+                        esig[a, s] = sig
+                        d = ede[a, s]
+                        q = 0.0
+                        if d[0] + d[1] < 0.0:
+                            q = d[6] / (d[0] + d[1])
+                        sf = sig + ti.Vector([-q, -q, 0.0, 0.0])
+                        fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
+                        efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
     # 2b. every copy takes its triangle's stress and N_e (from the computed copy)
     ti.loop_config(serialize=serial)
     for a in range(n):
@@ -952,12 +1016,34 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 st[0] += psum * inv
             else:
                 psig[i] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            M = pmat[i]
+            if ti.static(jwl):
+                if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                    p = pjwl[i][3]
+                    psig[i] = ti.Vector([-p, -p, 0.0, -p])
             if hit == 1:
                 st[1] = 1.0
             st[2] = ti.cast(cnt, ti.f64)
             pstate[i] = st
         else:
             xforce[i] = ti.Vector([0.0, 0.0])
+
+
+@ti.func
+def bulk_viscosity(matp: ti.template(), M, de, dt, area):
+    """Pressure q ≥ 0 of the artificial bulk viscosity of columns 12–13 (module
+    docstring of :mod:`physics.materials`), for a shrinking element only."""
+    q = 0.0
+    th = de[0] + de[1]
+    b1 = matp[M, 12]
+    b2 = matp[M, 13]
+    if th < 0.0 and b1 + b2 > 0.0:
+        L = ti.sqrt(ti.abs(area))
+        rate = -th / dt
+        rho = matp[M, 1]
+        c = ti.sqrt((matp[M, 2] + 4.0 * matp[M, 3] / 3.0) / rho)
+        q = rho * L * rate * (b1 * c + b2 * L * rate)
+    return q
 
 
 @ti.func

@@ -2,13 +2,13 @@
 
 The public API (see README): :class:`Simulation`, the contact laws
 :class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance`, the
-continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, the
+continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
 :class:`InputError`, :class:`InstabilityError`.
 """
 from coupling import PointEdge
 from physics import HertzMindlin, LinearContact, RollingResistance
-from physics.materials import Elastic, Fluid, MohrCoulomb
+from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 
 from . import mesh, pack
 from .errors import CapacityError, InputError, InstabilityError
@@ -17,5 +17,5 @@ from .simulation import Block, ParticleGroup, Simulation, Wall
 __version__ = "0.1.0"
 
 __all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "LinearContact", "HertzMindlin",
-           "RollingResistance", "PointEdge", "Elastic", "MohrCoulomb", "Fluid", "InputError",
+           "RollingResistance", "PointEdge", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack"]

@@ -154,7 +154,7 @@ def save(sim, path):
 
 
 # the continuum's state (the rest is set up again from the host description)
-_CONTINUUM_STATE = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags", "elem",
+_CONTINUUM_STATE = ("psig", "peps", "pstate", "pjwl", "xforce", "cand", "ccnt", "pflags", "elem",
                     "ecnt", "esig", "npos",
                     "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
                     "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")

@@ -22,7 +22,7 @@ import taichi as ti
 from coupling import point_edge as pe
 from physics import blocks as blk
 from physics import pcmm
-from physics.materials import MAT_WIDTH
+from physics.materials import JWL, MAT_WIDTH
 
 from . import backend
 from .errors import CapacityError, InputError
@@ -34,7 +34,7 @@ MAX_CANDIDATES = 1024
 RIGID_NODE = 8          # node flag: the node belongs to a free rigid block
 
 # arrays copied into the run segment's snapshot (the dynamic state)
-_SNAP = ("psig", "peps", "pstate", "xforce", "cand", "ccnt", "pflags", "elem", "ecnt", "esig",
+_SNAP = ("psig", "peps", "pstate", "pjwl", "xforce", "cand", "ccnt", "pflags", "elem", "ecnt", "esig",
          "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
          "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")
 
@@ -203,10 +203,14 @@ class Continuum:
         a["ncov"] = ti.ndarray(ti.i32, (n, E))
         a["esig"] = _arr(4, (n, E))
         a["efor"] = _arr(6, (n, E))
-        a["ede"] = _arr(5, (n, E))
+        a["ede"] = _arr(7, (n, E))
         a["psig"] = _arr(4, (n,))
         a["peps"] = _arr(3, (n,))
         a["pstate"] = _arr(4, (n,))
+        # JWL particles: relative volume V, energy E per initial volume, lighting time,
+        # pressure, initial volume m/ρ0 (physics.materials.JWL)
+        a["pjwl"] = _arr(5, (n,))
+        self._init_jwl(pmat)
         a["xforce"] = _arr(2, (n,))
         a["pinc"] = ti.ndarray(ti.i32, (n, pcmm.MAX_INCIDENT))
         a["picnt"] = ti.ndarray(ti.i32, (n,))
@@ -224,6 +228,33 @@ class Continuum:
         self.snap = {}
 
     # ------------------------------------------------------------------ set-up
+    def _init_jwl(self, pmat):
+        """V = 1, E = E0, never lit (t_l = +inf), p = 0, V0 = m/ρ0 for JWL particles."""
+        st = np.zeros((max(self.n, 1), 5))
+        st[:, 0] = 1.0
+        st[:, 2] = np.inf
+        st[:, 4] = 1.0
+        for s, (mat, _) in enumerate(self.slots):
+            if isinstance(mat, JWL):
+                sel = np.flatnonzero(pmat == s)
+                st[sel, 1] = mat.E0
+                st[sel, 4] = self.masses[sel] / mat.density
+        self.a["pjwl"].from_numpy(st)
+        self.jwl_ids = np.flatnonzero(np.isin(pmat, [s for s, (m, _) in enumerate(self.slots)
+                                                    if isinstance(m, JWL)]))
+
+    def light(self, ids, times):
+        """Set the lighting times t_l of JWL particles ``ids``."""
+        st = self.a["pjwl"].to_numpy()
+        st[ids, 2] = times
+        self.a["pjwl"].from_numpy(st)
+
+    def jwl_state(self):
+        """Per-particle JWL state: relative volume, energy per initial volume,
+        lighting time, pressure, initial volume (N, 5); rows of non-JWL particles are
+        unused."""
+        return self.a["pjwl"].to_numpy()[:self.n]
+
     def _initial_elements(self, pos, rad, pmat):
         """Eq. 5 masses and the shortest element altitude of each PCMM body, from
         its element system in the initial configuration."""
@@ -473,8 +504,8 @@ class Continuum:
                         a["elem"], a["ecnt"], a["earea"], a["ncov"], a["esig"], a["efor"],
                         a["ede"], a["psig"], a["peps"], a["pstate"], a["xforce"], e["nbr"],
                         e["ncnt"], e["cskip"], a["pinc"], a["picnt"], a["emult"], a["pflags"],
-                        a["elem_old"], a["esig_old"], a["ecnt_old"], float(dt),
-                        self.carry_stress, serial)
+                        a["elem_old"], a["esig_old"], a["ecnt_old"], a["pjwl"], float(dt),
+                        float(sim._time), self.carry_stress, len(self.jwl_ids) > 0, serial)
         if self.nv:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],

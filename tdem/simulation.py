@@ -363,6 +363,7 @@ class Simulation:
         self._cont = None          # Continuum (PCMM elements, blocks) once built
         self._couples = []         # (particle ids, block, PointEdge)
         self._nonreflect = []      # ("p" | "v", ids, coef rows) of viscous boundaries
+        self._lights = []          # (ids, lighting times) of JWL particles, before the build
         self._walls_host = []      # rows of the wall table
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
@@ -641,6 +642,38 @@ class Simulation:
                 out[k] = 0.5 * (dist[a] + dist[b])
         return out
 
+    def detonate(self, target, point, time=0.0):
+        """Programmed burn of JWL particles (:class:`tdem.JWL`): particle i lights at
+        t_l = ``time`` + |x_i − ``point``|/D (positions now) and releases its pressure
+        over the next 3R/D (the burn fraction). ``target``: particle indices or a
+        :class:`ParticleGroup` of JWL particles. Unlit JWL particles have no pressure.
+        """
+        from physics.materials import JWL
+        ids = target.ids if isinstance(target, ParticleGroup) else target
+        ids = np.atleast_1d(np.asarray(ids, np.int64))
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
+            raise InputError(f"target must be particle indices in [0, {self._n}) or a group, "
+                             f"got {np.asarray(ids).tolist()[:8]}")
+        slots = np.concatenate(self._host["mat"])[ids]
+        mats = {self._slots[int(k)][0] if k >= 0 else None for k in np.unique(slots)}
+        if len(mats) != 1 or not isinstance(next(iter(mats)), JWL):
+            raise InputError("target: detonate needs particles of one JWL material "
+                             "(add_particles(..., material=tdem.JWL...))")
+        point = np.asarray(point, dtype=float)
+        if point.shape != (2,) or not np.isfinite(point).all():
+            raise InputError(f"point must be a finite (x, y), got {point.tolist()!r}")
+        time = float(time)
+        if not math.isfinite(time):
+            raise InputError(f"time must be finite, got {time!r}")
+        pos = self._a["pos"].to_numpy()[ids] if self._built else \
+            np.concatenate(self._host["pos"])[ids]
+        times = time + np.linalg.norm(pos - point, axis=1) / next(iter(mats)).D
+        if self._built:
+            self._cont.light(ids, times)
+        else:
+            self._lights.append((ids, times))
+        return times
+
     @staticmethod
     def _unit_normals(normal, k):
         n = np.broadcast_to(np.asarray(normal, dtype=float), (k, 2)).copy()
@@ -908,6 +941,8 @@ class Simulation:
             for kind, ids, coef, block in self._nonreflect:
                 self._cont.set_non_reflecting(
                     kind, ids + block._offset if kind == "v" else ids, coef)
+            for ids, times in self._lights:
+                self._cont.light(ids, times)
         if self._n == 0:
             # blocks only: no particle arrays, the engine's parameters only
             self._a = {"simp": ti.ndarray(ti.f64, (stepk.SIMP_SIZE,))}
@@ -1486,7 +1521,9 @@ class Simulation:
         kinetic, gravitational (relative to the origin), elastic (springs),
         dissipated (damping, friction, rolling), boundary_work (done by walls and
         prescribed velocities) and total = kinetic + gravitational + elastic +
-        dissipated − boundary_work, which is conserved."""
+        dissipated − boundary_work, which is conserved for DEM models; explosive: the
+        internal energy Σ E·V0 of JWL particles (not in total: the strain energy of
+        the continuum elements is not counted)."""
         if not self._built:
             self._build()
         a = self._a
@@ -1500,7 +1537,16 @@ class Simulation:
              "boundary_work": float(eacc[:, 1].sum())}
         e["total"] = e["kinetic"] + e["gravitational"] + e["elastic"] + e["dissipated"] \
             - e["boundary_work"]
+        e["explosive"] = self._explosive_energy()
         return e
+
+    def _explosive_energy(self):
+        """Σ E_i·V0_i of the JWL particles (V0 = m/ρ0): their internal energy."""
+        c = self._cont
+        if c is None or not getattr(c, "has_pcmm", False) or len(c.jwl_ids) == 0:
+            return 0.0
+        st = c.jwl_state()[c.jwl_ids]
+        return float(np.sum(st[:, 1] * st[:, 4]))
 
     # ------------------------------------------------ monitors, output, checkpoints
     def monitor(self, name, fn, every=100):
