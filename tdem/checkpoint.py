@@ -273,6 +273,10 @@ def _restore_device(sim, state, cfg):
     have rebuilt them)."""
     import taichi as ti
 
+    if "hist" in state and state["hist"].shape[-1] == 4:
+        # written before the pair history held the overlap offset (step.pair_contact)
+        state["hist"] = np.concatenate([state["hist"], np.zeros(state["hist"].shape[:-1]
+                                                                + (1,))], axis=-1)
     sim._rebuild_from({k: np.array(v) for k, v in state.items()})
     a = sim._a
     ncount, nstart = cfg.get("cells", (a["cell_count"].shape[0], a["cell_start"].shape[0]))

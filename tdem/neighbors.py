@@ -150,14 +150,14 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             ncnt[i] = m
             for k in range(m):
                 j = nbr[i, k]
-                h = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                h = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
                 for kk in range(ncnt_old[i]):
                     if nbr_old[i, kk] == j:
                         h = hist_old[i, kk]
                 hist[i, k] = h
             for k in range(m, cap):
                 nbr[i, k] = -1
-                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
             xref[i] = xi
             rcnt[i] = 0
     # 6. reverse lists (who names me), then sorted for a fixed summation order

@@ -37,8 +37,8 @@ _PARTICLE = {
     "pos": 2, "vel": 2, "omega": 0, "prop": 3, "plaw": "i", "fix": "i", "vfix": 3,
     "force": 2, "torque": 0, "xref": 2, "pos0": 2, "facc": 3, "eacc": 2, "estate": 2,
 }
-_SLOTS = {"nbr": "i", "hist": 4, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
-          "nbr_old": "i", "hist_old": 4, "cskip": "i"}
+_SLOTS = {"nbr": "i", "hist": 5, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
+          "nbr_old": "i", "hist_old": 5, "cskip": "i"}
 _COUNTS = ("ncnt", "rcnt", "ncnt_old")
 _WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3, "wid_old": "i", "whist_old": 4}
 # arrays rebuilt from scratch whenever needed (never saved or restored)
@@ -926,7 +926,7 @@ class Simulation:
             "force": np.zeros((n, 2)), "torque": np.zeros(n), "xref": pos.copy(),
             "eacc": np.zeros((n, 2)), "estate": np.zeros((n, 2)),
             "nbr": -np.ones((n, self._cap), np.int32), "ncnt": np.zeros(n, np.int32),
-            "hist": np.zeros((n, self._cap, 4)),
+            "hist": np.zeros((n, self._cap, 5)),
             "wid": -np.ones((n, self._capw), np.int32),
             "whist": np.zeros((n, self._capw, 4)),
             "flags": np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32),
@@ -979,7 +979,7 @@ class Simulation:
                    "estate": np.zeros((n, 2)),
                    "nbr": -np.ones((n, state["nbr"].shape[1]), np.int32),
                    "ncnt": np.zeros(n, np.int32),
-                   "hist": np.zeros((n, state["hist"].shape[1], 4)),
+                   "hist": np.zeros((n, state["hist"].shape[1], 5)),
                    "wid": -np.ones((n, state["wid"].shape[1]), np.int32),
                    "whist": np.zeros((n, state["whist"].shape[1], 4))}
             for k, v in add.items():

@@ -63,7 +63,12 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     dist = d.norm()
     pj = prop[j]
     rj = pj[0]
-    u = ri + rj - dist
+    u_geo = ri + rj - dist
+    # a pair that shared PCMM elements until recently counts its overlap from the
+    # overlap it had then (hist[4], lowered as the two separate): the contact law
+    # takes over from the elements without a force jump (no energy from nowhere)
+    u0 = ti.min(hist[i, k][4], ti.max(u_geo, 0.0))
+    u = u_geo - u0
     f = ti.Vector([0.0, 0.0])
     m_on_i = 0.0
     m_on_j = 0.0
@@ -90,13 +95,13 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         f = -fn * n + fs_tot * t
         m_on_i = ai * fs_tot + m_tot
         m_on_j = aj * fs_tot - m_tot
-        hist[i, k] = ti.Vector([fs, m, th, brk])
+        hist[i, k] = ti.Vector([fs, m, th, brk, u0])
         diss = d1 + d2
         if ti.static(detail):
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, fs_tot, u])
     else:
-        hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+        hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, u0])
         if ti.static(detail):
             cs[i, k] = ti.Vector([0.0, 0.0, u])
     return f, m_on_i, m_on_j, diss
@@ -243,7 +248,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             if ti.static(continuum):
                 skip = cskip[i, k]
             if skip != 0:
-                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                # the elements carry this pair: remember its overlap (see pair_contact)
+                j = nbr[i, k]
+                u = pi[0] + prop[j][0] - (pos[j] - xi).norm()
+                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, ti.max(u, 0.0)])
                 if ti.static(detail):
                     cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
             else:
