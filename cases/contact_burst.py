@@ -32,12 +32,11 @@ Read-outs (summary.json)
   the run (and, for scale, the P-wave and Rayleigh-wave arrival times from the
   charge's contact point);
 - P4-P6 peak pressures and the ratios P5/P4, P6/P4 beside the paper's;
-- crater at the end (3.6 ms): columns of the rock lattice (bins one particle
-  diameter wide, by current x) whose top rock particle that moved less than one
-  diameter lies at least one lattice spacing (2R) below the original surface make
-  up the crater; its width is the span of those columns (plus one bin), its
-  depth the largest drop. Particles thrown out of the crater are not part of
-  the surface.
+- crater at the end (3.6 ms): its width is the span (one diameter per particle)
+  of the run of top-surface particles around the charge that have moved at least
+  one diameter (2R) — thrown out, spalled or driven in; its depth is the largest
+  drop, within that span, of the rock surface made of the particles that moved
+  less than a diameter (highest such particle per column one diameter wide).
 
 Presets
 -------
@@ -131,26 +130,32 @@ def crater(p, m):
     R = m["R"]
     ids = m["rock"].ids
     x = p["position"][ids]
-    disp = np.linalg.norm(x - m["x0"], axis=1)
-    keep = disp < 2 * R
+    x0 = m["x0"]
+    moved = np.linalg.norm(x - x0, axis=1) >= 2 * R
+    # width: the run of top-row particles, around the charge, that moved a diameter
+    top_row = np.flatnonzero(x0[:, 1] > H - 0.5 * R)
+    top_row = top_row[np.argsort(x0[top_row, 0])]
+    gone = moved[top_row]
+    c = int(np.argmin(np.abs(x0[top_row, 0] - W / 2)))
+    # the surface: highest particle that moved less than a diameter, per column
     bins = np.arange(0.0, W + 2 * R, 2 * R)
+    keep = ~moved
     which = np.clip(np.digitize(x[keep, 0], bins) - 1, 0, len(bins) - 2)
     top = np.full(len(bins) - 1, -np.inf)
     np.maximum.at(top, which, x[keep, 1])
     centres = 0.5 * (bins[1:] + bins[:-1])
     top[np.isinf(top)] = 0.0
-    low = top <= H - 2 * R + 1e-9
-    # the crater: the run of lowered columns around the charge's x
-    c = int(np.argmin(np.abs(centres - W / 2)))
-    if not low[c]:
+    if not gone[c]:
         return 0.0, 0.0, centres, top
     lo = hi = c
-    while lo > 0 and low[lo - 1]:
+    while lo > 0 and gone[lo - 1]:
         lo -= 1
-    while hi < len(low) - 1 and low[hi + 1]:
+    while hi < len(gone) - 1 and gone[hi + 1]:
         hi += 1
-    width = centres[hi] - centres[lo] + 2 * R
-    depth = H - top[lo:hi + 1].min()
+    x_lo, x_hi = x0[top_row[lo], 0] - R, x0[top_row[hi], 0] + R
+    width = x_hi - x_lo
+    span = (centres >= x_lo) & (centres <= x_hi)
+    depth = H - top[span].min()
     return float(width), float(depth), centres, top
 
 

@@ -38,14 +38,28 @@ def test_charge_products_expand_and_convert_energy(first_ms):
     assert 0.0 < 1.0 - ch["energy_left_fraction"] < 0.5
 
 
-@pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="a yielding weak Mohr-Coulomb rock (T = 0.05 MPa) "
-                   "gains kinetic energy after ~0.8 ms once most particles have failed "
-                   "(an elastic or strong rock stays bounded): open defect of the element "
-                   "system under failure")
-def test_whole_run_energy_and_crater(tmp_path):
-    s = contact_burst.run("quick", out=tmp_path)
+def _energy_bound(s):
+    """Kinetic energy + energy dissipated so far ≤ the energy the charge gave up
+    (the viscous boundaries only take energy away)."""
     e = s["energy_J_per_m"]
     converted = 7.0e9 * s["charge_initial_volume_m2"] - e["explosive"]
-    assert e["kinetic"] <= 1.02 * converted
-    assert s["crater_depth_m"]["value"] > 0.0
+    assert converted > 0.0
+    assert e["kinetic"] + e["dissipated"] <= 1.02 * converted
+
+
+def test_no_energy_from_nowhere_in_the_first_millisecond(first_ms):
+    """Failing rock near the surface loses its elements while compressed; the
+    contact law then takes over without a force jump (before that fix the rock's
+    kinetic energy grew past the charge's whole output by 1 ms)."""
+    _energy_bound(first_ms)
+
+
+@pytest.mark.slow
+def test_whole_run_crater_and_energy(tmp_path):
+    """3.6 ms: a crater wider than the charge and at least one layer of particles
+    deep; still no energy from nowhere. (The measured crater is compared with the
+    paper's 1.4 m x 0.35 m in summary.json and the README.)"""
+    s = contact_burst.run("quick", out=tmp_path)
+    _energy_bound(s)
+    assert s["crater_width_m"]["value"] > 2 * contact_burst.CHARGE_RADIUS
+    assert s["crater_depth_m"]["value"] >= 2 * s["radius_m"]
