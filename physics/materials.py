@@ -80,8 +80,10 @@ any material from one 2D array ``matp[M, col]``:
 1     density ρ (kg/m³)
 2     bulk modulus K (Pa)
 3     shear modulus G (Pa) (0 for a Fluid)
-4     cohesion c (Pa)                         (Mohr–Coulomb, else 0)
-5     tension cut-off T in use, capped (Pa)   (Mohr–Coulomb, else 0)
+4     cohesion c (Pa)                         (Mohr–Coulomb; Fluid: 1 with the
+                                             equation of state; else 0)
+5     tension cut-off T in use, capped (Pa)   (Mohr–Coulomb; Fluid: its tensile
+                                             strength; else 0)
 6     N_φ = (1 + sin φ)/(1 − sin φ)           (Mohr–Coulomb, else 1)
 7     N_ψ = (1 + sin ψ)/(1 − sin ψ)           (Mohr–Coulomb, else 1)
 8     brittle softening: 1 on, 0 off
@@ -278,30 +280,86 @@ class Fluid(Material):
 
     Parameters
     ----------
-    density : ρ (kg/m³), > 0
-    bulk_modulus : K (Pa), > 0 (the paper: 2 GPa; a case may lower it, see §3)
-    viscosity : dynamic viscosity μ (Pa·s), ≥ 0 (its stress is handled by the
-        element update, not by ``mc_correct``, which leaves the stress unchanged)
+    density : ρ0 (kg/m³), > 0, the density at zero pressure
+    bulk_modulus : K (Pa), > 0 (the paper: 2 GPa; a case may lower it to a weakly
+        compressible value, c = sqrt(K/ρ0) ≥ 10 × the largest flow speed, spec §3)
+    viscosity : dynamic viscosity μ (Pa·s), ≥ 0: the stress 2μ·dev(D) on the
+        element forces of each step (not accumulated)
     linear_viscosity, quadratic_viscosity : artificial bulk viscosity b1, b2 ≥ 0
         (module docstring; 0 = off)
+    tensile_strength : only with ``equation_of_state``: the largest tension
+        (negative pressure) the fluid carries, Pa, ≥ 0 (default 0)
+    equation_of_state : False (default): the pressure is the elements'
+        incremental stress of Eqs. 6–11 with G = 0, as for the solids (each
+        element carries its own stress from step to step; a new element starts
+        from the mean of its particles' stresses). True: the pressure is a state
+        of the particles, p = max(K·(1/V − 1), −tensile_strength), V the relative
+        volume each particle carries (changed by a third of Σ_e (S_e/N_e)·Δθ_e
+        over the elements containing it, divided by its initial volume M_i/ρ0:
+        the JWL bookkeeping of :mod:`physics.pcmm`); an element pushes with the
+        mean pressure of its three particles, plus the viscous stress and q.
+
+    Contacts between water particles. Two particles of one Fluid body that are
+    Eq. 1 neighbours never meet through the contact law; they repel through the
+    core force of :func:`physics.pcmm.fluid_core_force`, K·max(0, 0.75·(R_i +
+    R_j) − d), a function of their distance only. Why: with G = 0 the triangles
+    resist only area changes, so two particles of one triangle can approach each
+    other at constant area down to the Eq. 3 edge limit (0.5 × the mean radius,
+    i.e. an overlap of 1.5 R) before the Eq. 2 angle check deletes the triangle;
+    the spec's rule (touching particles that share no element meet through the
+    contact law, in total form F = k_n·u_n) then switches on a force k_n × that
+    overlap in one step. In a water column of 0.3 × 0.4 m released as a dam
+    break (R = 1 cm, K = 2 MPa) this threw the toe particles out at 100 m/s
+    after 0.08 s, at any time step (0.5 and 0.1 × the critical one); the water
+    column at rest of R = 6–14 mm random discs, and the reported corner
+    instability of the wall-bounded column, are the same event. The core force
+    does no work unless two particles overlap by a quarter of their radii, far
+    beyond the water's compression (p/K < 1 %), so it leaves the pressure alone.
+
+    The two pressure models, measured (tests/test_fluid.py set-up: 0.4 × 0.5 m,
+    R = 1 cm square lattice, K = 2 MPa, μ = 1 Pa·s, damped 0.3 s, then free):
+    the incremental model holds the column at rest (largest speed < 1e-6 m/s
+    over 3 s undamped); the equation of state lets it creep along the
+    zero-energy shear modes of the G = 0 lattice (largest speed growing from
+    1 to 4 mm/s over 1.2 s, then the column rearranges after 1.8 s), because
+    averaging the particle pressures over each triangle leaves the lattice
+    without an exact equilibrium. In the dam break the equation of state gives
+    the faster front (0.91 m at 0.3 s against 0.73 m incremental; Martin &
+    Moyce's experiment: about 0.9 m) and loses less energy. Both lose volume
+    when a random packing flows (the area of deleted triangles is not
+    returned to anyone), so water is best packed on a lattice.
     """
 
     _ARGS = ("density", "bulk_modulus", "viscosity", "linear_viscosity",
-             "quadratic_viscosity")
+             "quadratic_viscosity", "tensile_strength", "equation_of_state")
 
     def __init__(self, density=1000.0, bulk_modulus=2e9, viscosity=0.0,
-                 linear_viscosity=0.0, quadratic_viscosity=0.0):
+                 linear_viscosity=0.0, quadratic_viscosity=0.0, tensile_strength=0.0,
+                 equation_of_state=False):
         self.density = positive("density", density)
         self.bulk_modulus = positive("bulk_modulus", bulk_modulus)
         self.viscosity = non_negative("viscosity", viscosity)
         self.linear_viscosity = non_negative("linear_viscosity", linear_viscosity)
         self.quadratic_viscosity = non_negative("quadratic_viscosity", quadratic_viscosity)
+        self.tensile_strength = non_negative("tensile_strength", tensile_strength)
+        if equation_of_state not in (True, False):
+            raise InputError(f"equation_of_state must be True or False, got "
+                             f"{equation_of_state!r}")
+        self.equation_of_state = bool(equation_of_state)
         self.bulk = self.bulk_modulus
         self.shear = 0.0
 
+    def pressure(self, V):
+        """Equation of state p(V) of ``equation_of_state=True`` (numpy)."""
+        V = np.asarray(V, dtype=float)
+        return np.maximum(self.bulk * (1.0 / V - 1.0), -self.tensile_strength)
+
     def row(self):
+        # column 4: 1 with the equation of state; column 5 (the tension cut-off of
+        # a Mohr–Coulomb row) the fluid's tensile strength
         return [float(FLUID), self.density, self.bulk, 0.0,
-                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, self.viscosity,
+                1.0 if self.equation_of_state else 0.0, self.tensile_strength, 1.0, 1.0,
+                0.0, 0.0, 0.0, self.viscosity,
                 self.linear_viscosity, self.quadratic_viscosity]
 
 
@@ -382,6 +440,12 @@ def jwl_pressure(matp: ti.template(), M, V, E):
     A, B, R1, R2, w = matp[M, 4], matp[M, 5], matp[M, 6], matp[M, 7], matp[M, 8]
     return (A * (1.0 - w / (R1 * V)) * ti.exp(-R1 * V)
             + B * (1.0 - w / (R2 * V)) * ti.exp(-R2 * V) + w * E / V)
+
+
+@ti.func
+def fluid_pressure(matp: ti.template(), M, V):
+    """Equation of state of the Fluid row M at relative volume V (:class:`Fluid`)."""
+    return ti.max(matp[M, 2] * (1.0 / V - 1.0), -matp[M, 5])
 
 
 # ------------------------------------------------------------------ kernel side

@@ -70,7 +70,7 @@ from tdem import backend
 from tdem.errors import CapacityError, InputError
 
 from . import fvm
-from .materials import JWL_TYPE, jwl_pressure, mc_correct_state
+from .materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
 from .validate import positive
 
 MAX_ELEMENTS = 12        # elements a particle can create (pruned gaps are >= 30 deg)
@@ -640,6 +640,7 @@ P_NEED = 0       # largest number of Eq. 1 candidates of any particle
 P_BUILDS = 1     # engine list build the candidates were made from (−1: none yet)
 P_INC = 2        # largest number of elements containing one particle
 PFLAGS_SIZE = 4
+FLUID_CORE = 0.75  # λ of fluid_core_force
 MAX_INCIDENT = 64  # slots of a particle's list of the elements containing it
 
 
@@ -952,6 +953,49 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                         sf = sig + ti.Vector([-q, -q, 0.0, 0.0])
                         fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
                         efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+    if ti.static(jwl):
+        # 2f. Fluid particles with ``equation_of_state`` (column 4 = 1; ``jwl`` is set
+        #     whenever particles carry an equation of state: JWL or such a Fluid): the
+        #     relative volume V of each particle changes by a
+        #     third of Σ_e (S_e/N_e) Δθ_e over its elements, as for JWL, and its
+        #     pressure is the equation of state p(V) of :class:`physics.materials.Fluid`
+        #     (a state function: deleting or creating elements does not change it).
+        ti.loop_config(serialize=serial)
+        for i in range(n):
+            M = pmat[i]
+            if M >= 0:
+                if ti.cast(matp[M, 0], ti.i32) == FLUID and matp[M, 4] > 0.0:
+                    thsum = 0.0
+                    for k in range(icnt[i]):
+                        code = inc[i, k]
+                        o = code >> 4
+                        sl = code & 15
+                        d = ede[o, sl]
+                        thsum += ti.cast(emult[o, sl], ti.f64) * d[5] * (d[0] + d[1])
+                    js = pjwl[i]
+                    V = js[0] + thsum / (3.0 * js[4])
+                    pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), js[4]])
+        # 2g. Fluid elements: the mean pressure of their particles, the viscous stress
+        #     2μ·dev(D) and the artificial bulk viscosity q (forces only)
+        ti.loop_config(serialize=serial)
+        for a in range(n):
+            for s in range(ecnt[a]):
+                if emult[a, s] > 0:
+                    M = pmat[a]
+                    if ti.cast(matp[M, 0], ti.i32) == FLUID and matp[M, 4] > 0.0:
+                        b = elem[a, s, 0]
+                        c = elem[a, s, 1]
+                        pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
+                        sig = ti.Vector([-pm, -pm, 0.0, -pm])
+                        esig[a, s] = sig
+                        d = ede[a, s]
+                        de = ti.Vector([d[0], d[1], d[2]])
+                        q = 0.0
+                        if d[0] + d[1] < 0.0:
+                            q = d[6] / (d[0] + d[1])
+                        sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
+                        fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
+                        efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
     # 2b. every copy takes its triangle's stress and N_e (from the computed copy)
     ti.loop_config(serialize=serial)
     for a in range(n):
@@ -998,7 +1042,6 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                     if d[4] > 0.0:
                         hit = 1
                     cnt += mw
-            xforce[i] = f
             # no DEM contact with a same-body Eq. 1 neighbour when either of the two is
             # in an element: the elements carry their interaction (both lists sorted)
             q = 0
@@ -1006,8 +1049,20 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 j = enbr[i, k]
                 while q < ncnt[i] and nbr[i, q] < j:
                     q += 1
-                if q < ncnt[i] and nbr[i, q] == j and (icnt[i] > 0 or icnt[j] > 0):
-                    cskip[i, k] = 1
+                if q < ncnt[i] and nbr[i, q] == j:
+                    if icnt[i] > 0 or icnt[j] > 0 or \
+                            ti.cast(matp[pmat[i], 0], ti.i32) == FLUID:
+                        cskip[i, k] = 1
+            if ti.cast(matp[pmat[i], 0], ti.i32) == FLUID:
+                # Fluid: same-body Eq. 1 neighbours never meet through the contact law
+                # (whose force, switched on when an element between them is deleted,
+                # starts at their full overlap); they repel through the core force
+                # of fluid_core_force, a function of their distance only
+                xi = pos[i]
+                for q2 in range(ncnt[i]):
+                    j = nbr[i, q2]
+                    f += fluid_core_force(matp, pmat[i], xi, pos[j], rad[i] + rad[j])
+            xforce[i] = f
             st = pstate[i]
             if cnt > 0:
                 inv = 1.0 / cnt
@@ -1019,6 +1074,9 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
             M = pmat[i]
             if ti.static(jwl):
                 if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                    p = pjwl[i][3]
+                    psig[i] = ti.Vector([-p, -p, 0.0, -p])
+                elif ti.cast(matp[M, 0], ti.i32) == FLUID and matp[M, 4] > 0.0:
                     p = pjwl[i][3]
                     psig[i] = ti.Vector([-p, -p, 0.0, -p])
             if hit == 1:
@@ -1044,6 +1102,24 @@ def bulk_viscosity(matp: ti.template(), M, de, dt, area):
         c = ti.sqrt((matp[M, 2] + 4.0 * matp[M, 3] / 3.0) / rho)
         q = rho * L * rate * (b1 * c + b2 * L * rate)
     return q
+
+
+@ti.func
+def fluid_core_force(matp: ti.template(), M, xi, xj, rsum):
+    """Force on particle i (at xi) from a same-body Fluid neighbour j (at xj):
+    a linear repulsive core, K·max(0, λ·(R_i + R_j) − d) along the line of centres,
+    λ = FLUID_CORE (K of row M as a stiffness per metre of thickness). It stands in
+    for the contact law between water particles (:class:`physics.materials.Fluid`):
+    zero unless the two overlap by more than (1 − λ) of their radii, far beyond any
+    compression the water's pressure gives (p/K < 1 %), and a function of their
+    distance only, so it has a potential and cannot jump when elements come and go."""
+    d = xj - xi
+    L = d.norm()
+    dc = FLUID_CORE * rsum
+    out = ti.Vector([0.0, 0.0])
+    if L < dc and L > 0.0:
+        out = -matp[M, 2] * (dc - L) / L * d
+    return out
 
 
 @ti.func

@@ -22,7 +22,7 @@ import taichi as ti
 from coupling import point_edge as pe
 from physics import blocks as blk
 from physics import pcmm
-from physics.materials import JWL, MAT_WIDTH
+from physics.materials import JWL, MAT_WIDTH, Fluid
 
 from . import backend
 from .errors import CapacityError, InputError
@@ -239,9 +239,15 @@ class Continuum:
                 sel = np.flatnonzero(pmat == s)
                 st[sel, 1] = mat.E0
                 st[sel, 4] = self.masses[sel] / mat.density
+            elif isinstance(mat, Fluid):   # relative volume and V0 of the Fluid EOS
+                sel = np.flatnonzero(pmat == s)
+                st[sel, 4] = self.masses[sel] / mat.density
         self.a["pjwl"].from_numpy(st)
         self.jwl_ids = np.flatnonzero(np.isin(pmat, [s for s, (m, _) in enumerate(self.slots)
                                                     if isinstance(m, JWL)]))
+        # the update kernel's JWL/EOS passes also carry the Fluid equation of state
+        self.eos = len(self.jwl_ids) > 0 or any(isinstance(m, Fluid) and m.equation_of_state
+                                                for m, _ in self.slots)
 
     def light(self, ids, times):
         """Set the lighting times t_l of JWL particles ``ids``."""
@@ -505,7 +511,7 @@ class Continuum:
                         a["ede"], a["psig"], a["peps"], a["pstate"], a["xforce"], e["nbr"],
                         e["ncnt"], e["cskip"], a["pinc"], a["picnt"], a["emult"], a["pflags"],
                         a["elem_old"], a["esig_old"], a["ecnt_old"], a["pjwl"], float(dt),
-                        float(sim._time), self.carry_stress, len(self.jwl_ids) > 0, serial)
+                        float(sim._time), self.carry_stress, self.eos, serial)
         if self.nv:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],

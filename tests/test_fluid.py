@@ -1,0 +1,135 @@
+"""Water column at rest (tdem.Fluid): hydrostatic pressure and no spurious flow.
+
+Set-up: PCMM water (ρ = 1000 kg/m³, K = 2 MPa, μ = 1 Pa·s) on a square lattice of
+R = 1 cm discs, 0.4 m wide and 0.5 m high (20 × 25 = 500 particles, δ = R), in a
+tank of three frictionless walls (the particle–wall contact law, k_n = 3K). Walls
+rather than fixed particles or a block: they are what the water_blocks case uses
+and the cheapest rigid boundary; frictionless, because a hydrostatic wall carries
+no shear.
+
+Weak compressibility: c = sqrt(K/ρ) = 44.7 m/s ≥ 10 × sqrt(2·g·h) = 31.3 m/s.
+
+Initialisation: 0.3 s with local damping 0.7 (the column is released at zero
+pressure and settles onto its hydrostatic state), then the damping is switched
+off and the undamped part is measured over 2.0 s: about 44 acoustic periods
+4h/c = 0.045 s and 2.8 periods of the first sloshing mode of the tank
+(ω² = (gπ/L)·tanh(πh/L), T = 0.72 s).
+
+Checks (undamped part):
+- pressure at depth: the particles of the middle half of the width (0.1–0.3 m),
+  from the third row below the surface down to the second row above the floor
+  (rows 2–22 counted from the top row 0), against ρ·g·d, d the depth below the
+  free surface. The particle pressures are nodal values: the surface row carries
+  p = 0 (the discrete free-surface condition), so d is measured from the top
+  row's centres: within 5 % (measured: 0.1 %). Measured from the top row's
+  edge (centre + R, the surface of the water's mass) the nodal values lag by
+  ρ·g·R: still within 5 % from 0.25 m depth down (rows 13–22; measured 3.65 %).
+- no flow: every particle slower than 1 % of sqrt(g·h) = 0.022 m/s (measured:
+  at most 1.4e-5 m/s).
+
+A dam break (the same water, 0.3 × 0.4 m, released at rest with no damping in
+a 1 m tank) checks the flow: before the fluid core force (physics.materials.Fluid)
+it threw its toe particles out at 100 m/s after 0.08 s. Now it runs, its energy
+does not grow, and its front at t = 0.3 s (max x of the particles) lies within
+25 % of Martin & Moyce's (1952) measured surge front, x/a ≈ 3.0 at
+T = t·sqrt(2g/a) = 2.43, i.e. 0.9 m (measured 0.73 m: the incremental
+pressure loses energy to element turnover; see physics.materials.Fluid).
+"""
+import math
+
+import numpy as np
+import pytest
+
+import tdem
+
+R, W, H = 0.01, 0.4, 0.5
+RHO, K, MU = 1000.0, 2e6, 1.0
+G = 9.81
+
+
+@pytest.fixture(scope="module")
+def column():
+    water = tdem.Fluid(density=RHO, bulk_modulus=K, viscosity=MU)
+    sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5, local_damping=0.7)
+    pos, r = tdem.pack.regular(W, H, R)
+    g = sim.add_particles(pos, r, material=water, tolerance=R)
+    wall = tdem.LinearContact(kn=3.0 * K, ks=0.0, friction=0.0)
+    sim.add_wall((0.0, 0.0), (W, 0.0), contact=wall)
+    sim.add_wall((0.0, 2 * H), (0.0, 0.0), contact=wall)
+    sim.add_wall((W, 0.0), (W, 2 * H), contact=wall)
+    sim.run(until=0.3)
+    sim.local_damping = 0.0
+    t0 = sim.time
+    vmax, errs, errs_edge = [], [], []
+    while sim.time < t0 + 2.0 - 1e-9:
+        sim.run(until=sim.time + 0.2)
+        p = sim.particles.numpy()
+        vmax.append(float(np.linalg.norm(p["velocity"], axis=1).max()))
+        errs.append(pressure_errors(p, 0.0, 0.03))
+        errs_edge.append(pressure_errors(p, R, 0.24))
+    return {"n": len(g.ids), "vmax": np.array(vmax), "err": np.array(errs),
+            "err_edge": np.array(errs_edge)}
+
+
+def pressure_errors(p, above, dmin):
+    """Largest |p/(ρ g d) − 1| over the middle half of the width, rows from depth
+    dmin (below the top row's centres) to the second row above the floor; d is
+    measured from ``above`` metres over the top row's centres."""
+    x, y, pr = p["position"][:, 0], p["position"][:, 1], p["pressure"]
+    below_top = y.max() - y
+    sel = (x > 0.1) & (x < 0.3) & (below_top > dmin) & (y > 1.5 * R + 2 * R)
+    depth = below_top[sel] + above
+    return float(np.max(np.abs(pr[sel] / (RHO * G * depth) - 1.0)))
+
+
+def test_sound_speed_is_weakly_compressible():
+    assert math.sqrt(K / RHO) >= 10.0 * math.sqrt(2.0 * G * H)
+
+
+def test_hydrostatic_pressure(column):
+    assert column["n"] == 500
+    # measured: largest relative error 0.0010 over the ten samples
+    assert column["err"].max() < 0.05
+    # measured from the mass surface (top row's edge), deep rows only: 0.0365
+    assert column["err_edge"].max() < 0.05
+
+
+def test_no_flow(column):
+    limit = 0.01 * math.sqrt(G * H)
+    # measured: largest particle speed over the ten samples 1.4e-5 m/s
+    assert column["vmax"].max() < limit
+
+
+def test_eos_pressure():
+    water = tdem.Fluid(density=RHO, bulk_modulus=K)
+    assert water.pressure(1.0) == 0.0
+    assert water.pressure(0.99) == pytest.approx(K * (1 / 0.99 - 1), rel=1e-12)
+    assert water.pressure(1.01) == 0.0          # no tension by default
+    w2 = tdem.Fluid(density=RHO, bulk_modulus=K, tensile_strength=1e3)
+    assert w2.pressure(1.5) == -1e3
+
+
+def test_dam_break():
+    a, h = 0.3, 0.4
+    water = tdem.Fluid(density=RHO, bulk_modulus=K, viscosity=MU)
+    sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5)
+    pos, r = tdem.pack.regular(a, h, R)
+    sim.add_particles(pos, r, material=water, tolerance=R)
+    wall = tdem.LinearContact(kn=3.0 * K, ks=0.0, friction=0.0)
+    sim.add_wall((0.0, 0.0), (1.0, 0.0), contact=wall)
+    sim.add_wall((0.0, 1.0), (0.0, 0.0), contact=wall)
+    sim.add_wall((1.0, 0.0), (1.0, 1.0), contact=wall)
+    sim.run(steps=1)
+    e0 = sim.energy()
+    total0 = e0["kinetic"] + e0["gravitational"]
+    sim.run(until=0.3)
+    e = sim.energy()
+    p = sim.particles.numpy()
+    front = float(p["position"][:, 0].max() + R)
+    T = 0.3 * math.sqrt(2 * G / a)
+    assert T == pytest.approx(2.43, abs=0.01)
+    # Martin & Moyce: x/a = 3.0 at T = 2.43 → 0.9 m; measured 0.73 m
+    assert front == pytest.approx(3.0 * a, rel=0.25)
+    # no energy created (measured: 178.2 J of 208.8 J left)
+    assert e["kinetic"] + e["gravitational"] <= total0
+    assert float(np.linalg.norm(p["velocity"], axis=1).max()) < 2.0 * math.sqrt(G * h) * 1.5
