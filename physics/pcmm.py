@@ -760,7 +760,8 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
            icnt: ti.types.ndarray(), emult: ti.types.ndarray(), pflags: ti.types.ndarray(),
            elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
            ecnt_old: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
-           time: ti.f64, carry: ti.template(), jwl: ti.template(), serial: ti.template()):
+           time: ti.f64, first: ti.i32, carry: ti.template(), jwl: ti.template(),
+           serial: ti.template()):
     """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16), for the particles of x_n
     moving at v_{n−1/2}:
 
@@ -772,13 +773,17 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
        nodal forces with the weight 1/N_e (Eqs. 13–14, sign fixed);
     3. per particle (gathered, no atomics): force of its elements → xforce,
        stress = mean of its elements' σ (zero in none), strain and plastic shear
-       strain += the means of the increments; the engine's pair slots of same-body
-       Eq. 1 neighbours of which at least one is in an element are marked in
-       ``cskip``: no DEM contact between them, the elements carry their
-       interaction (a pair that touches but was left out of the elements by the
-       angular pruning would otherwise push apart by its initial overlap at the
-       contact law's stiffness). Particles of different bodies, and particles in
-       no element, meet through the contact law.
+       strain += the means of the increments; the engine's pair slots (``cskip``):
+       1 for two particles that are corners of a common element (no DEM contact:
+       the element carries their interaction; the contact law records their
+       overlap, from which it counts when it takes over, see
+       :func:`tdem.step.pair_contact`), and for same-body Fluid neighbours
+       (:func:`fluid_core_force`); 2, at the first step only, for the other
+       same-body Eq. 1 neighbours (the contact law starts from their initial
+       overlap: a touching pair left out of the elements by the angular pruning
+       does not push apart). All other touching pairs — sharing no element,
+       whether in elements or not, same body or not — meet through the contact
+       law, so that particles cannot pass through each other.
 
     pstate[i] = (plastic shear strain, failed (0/1), elements containing i, −).
     """
@@ -1050,9 +1055,11 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 while q < ncnt[i] and nbr[i, q] < j:
                     q += 1
                 if q < ncnt[i] and nbr[i, q] == j:
-                    if icnt[i] > 0 or icnt[j] > 0 or \
-                            ti.cast(matp[pmat[i], 0], ti.i32) == FLUID:
+                    if ti.cast(matp[pmat[i], 0], ti.i32) == FLUID or \
+                            _shares_element(i, j, inc, icnt, elem):
                         cskip[i, k] = 1
+                    elif first != 0:
+                        cskip[i, k] = 2
             if ti.cast(matp[pmat[i], 0], ti.i32) == FLUID:
                 # Fluid: same-body Eq. 1 neighbours never meet through the contact law
                 # (whose force, switched on when an element between them is deleted,
@@ -1102,6 +1109,19 @@ def bulk_viscosity(matp: ti.template(), M, de, dt, area):
         c = ti.sqrt((matp[M, 2] + 4.0 * matp[M, 3] / 3.0) / rho)
         q = rho * L * rate * (b1 * c + b2 * L * rate)
     return q
+
+
+@ti.func
+def _shares_element(i, j, inc: ti.template(), icnt: ti.template(), elem: ti.template()):
+    """Whether j is a corner of one of the (computed) elements containing i."""
+    found = False
+    for q in range(icnt[i]):
+        code = inc[i, q]
+        o = code >> 4
+        s = code & 15
+        if o == j or elem[o, s, 0] == j or elem[o, s, 1] == j:
+            found = True
+    return found
 
 
 @ti.func

@@ -511,7 +511,8 @@ class Continuum:
                         a["ede"], a["psig"], a["peps"], a["pstate"], a["xforce"], e["nbr"],
                         e["ncnt"], e["cskip"], a["pinc"], a["picnt"], a["emult"], a["pflags"],
                         a["elem_old"], a["esig_old"], a["ecnt_old"], a["pjwl"], float(dt),
-                        float(sim._time), self.carry_stress, self.eos, serial)
+                        float(sim._time), int(sim.steps == 0), self.carry_stress,
+                        self.eos, serial)
         if self.nv:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],

@@ -247,7 +247,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             skip = 0
             if ti.static(continuum):
                 skip = cskip[i, k]
-            if skip != 0:
+            if skip == 1:
                 # the elements carry this pair: remember its overlap (see pair_contact)
                 j = nbr[i, k]
                 u = pi[0] + prop[j][0] - (pos[j] - xi).norm()
@@ -255,6 +255,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if ti.static(detail):
                     cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
             else:
+                if skip == 2:
+                    # a same-body pair at the start: the contact law counts from now
+                    j = nbr[i, k]
+                    u = pi[0] + prop[j][0] - (pos[j] - xi).norm()
+                    h0 = hist[i, k]
+                    h0[4] = ti.max(u, 0.0)
+                    hist[i, k] = h0
                 fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel,
                                                omega, prop, plaw, lawp, lawpair, nbr, hist, cn,
                                                cs, dt, detail)
