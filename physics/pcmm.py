@@ -777,7 +777,7 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
        1 for two particles that are corners of a common element (no DEM contact:
        the element carries their interaction; the contact law records their
        overlap, from which it counts when it takes over, see
-       :func:`tdem.step.pair_contact`), and for same-body Fluid neighbours
+       :func:`tdem.step.pair_contact`), and for same-body Fluid or JWL neighbours
        (:func:`fluid_core_force`); 2, at the first step only, for the other
        same-body Eq. 1 neighbours (the contact law starts from their initial
        overlap: a touching pair left out of the elements by the angular pruning
@@ -1047,24 +1047,26 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                     if d[4] > 0.0:
                         hit = 1
                     cnt += mw
-            # no DEM contact with a same-body Eq. 1 neighbour when either of the two is
-            # in an element: the elements carry their interaction (both lists sorted)
+            # pair slots of same-body Eq. 1 neighbours (both lists sorted): 1, no DEM
+            # contact, when they share an element or are fluid (Fluid, JWL); 2 at the
+            # first step for the others (docstring)
+            kind_i = ti.cast(matp[pmat[i], 0], ti.i32)
+            fluid = kind_i == FLUID or kind_i == JWL_TYPE
             q = 0
             for k in range(encnt[i]):
                 j = enbr[i, k]
                 while q < ncnt[i] and nbr[i, q] < j:
                     q += 1
                 if q < ncnt[i] and nbr[i, q] == j:
-                    if ti.cast(matp[pmat[i], 0], ti.i32) == FLUID or \
-                            _shares_element(i, j, inc, icnt, elem):
+                    if fluid or _shares_element(i, j, inc, icnt, elem):
                         cskip[i, k] = 1
                     elif first != 0:
                         cskip[i, k] = 2
-            if ti.cast(matp[pmat[i], 0], ti.i32) == FLUID:
-                # Fluid: same-body Eq. 1 neighbours never meet through the contact law
-                # (whose force, switched on when an element between them is deleted,
-                # starts at their full overlap); they repel through the core force
-                # of fluid_core_force, a function of their distance only
+            if fluid:
+                # Fluid and JWL products: same-body Eq. 1 neighbours never meet through
+                # the contact law (no friction between fluid particles, and no force
+                # jump when an element between them goes); they repel through the core
+                # force of fluid_core_force, a function of their distance only
                 xi = pos[i]
                 for q2 in range(ncnt[i]):
                     j = nbr[i, q2]
@@ -1126,10 +1128,11 @@ def _shares_element(i, j, inc: ti.template(), icnt: ti.template(), elem: ti.temp
 
 @ti.func
 def fluid_core_force(matp: ti.template(), M, xi, xj, rsum):
-    """Force on particle i (at xi) from a same-body Fluid neighbour j (at xj):
+    """Force on particle i (at xi) from a same-body Fluid or JWL neighbour j (at xj):
     a linear repulsive core, K·max(0, λ·(R_i + R_j) − d) along the line of centres,
     λ = FLUID_CORE (K of row M as a stiffness per metre of thickness). It stands in
-    for the contact law between water particles (:class:`physics.materials.Fluid`):
+    for the contact law between water particles (:class:`physics.materials.Fluid`)
+    and between detonation products (K = ρ0 D² of a JWL row):
     zero unless the two overlap by more than (1 − λ) of their radii, far beyond any
     compression the water's pressure gives (p/K < 1 %), and a function of their
     distance only, so it has a potential and cannot jump when elements come and go."""

@@ -356,20 +356,21 @@ class Continuum:
         rows ("p" arrays) and block-vertex rows ("v" arrays: both ways for a pair of
         blocks) are kept apart: their points live in different arrays."""
         self.nq = {"p": 0, "v": 0}
-        rows = {"p": ([], [], [], [], [], []), "v": ([], [], [], [], [], [])}
+        rows = {"p": ([], [], [], [], [], [], []), "v": ([], [], [], [], [], [], [])}
         for ids, a, block, law, kn, ks in couples:
             if a is None:           # particles ids against block
                 pairs = [("p", np.asarray(ids, np.int64), None, block)]
             else:                   # vertices of a against edges of block, and back
                 pairs = [("v", None, a, block), ("v", None, block, a)]
             for kind, pid, src, dst in pairs:
-                parts, cpl, ranges, edges, laws, rad = rows[kind]
+                parts, cpl, ranges, edges, laws, rad, nbr = rows[kind]
                 k = len(laws)
                 be = _boundary_edges(dst.triangles) + dst._offset
                 e0 = sum(len(x) for x in edges)
                 if kind == "p":
                     pts = pid
                     r = self._radius_of(pid)
+                    nb = -np.ones((len(pid), 2), np.int64)
                 else:
                     sb = _boundary_edges(src.triangles)
                     vs = np.unique(sb)
@@ -379,14 +380,21 @@ class Continuum:
                     np.add.at(trib, sb[:, 1], 0.5 * ln)
                     pts = vs + src._offset
                     r = -trib[vs]
+                    # each vertex's neighbours on its own boundary (the entrance rule)
+                    prev = np.full(len(src.vertices), -1, np.int64)
+                    nxt = np.full(len(src.vertices), -1, np.int64)
+                    prev[sb[:, 1]] = sb[:, 0]
+                    nxt[sb[:, 0]] = sb[:, 1]
+                    nb = np.column_stack([prev[vs], nxt[vs]]) + src._offset
                 parts.append(np.asarray(pts, np.int32))
                 cpl.append(np.full(len(pts), k, np.int32))
                 ranges.append((e0, e0 + len(be)))
                 edges.append(be)
                 laws.append(law.row(kn, ks))
                 rad.append(np.asarray(r, float))
+                nbr.append(nb.astype(np.int32))
         a = self.a
-        for kind, (parts, cpl, ranges, edges, laws, rad) in rows.items():
+        for kind, (parts, cpl, ranges, edges, laws, rad, nbr) in rows.items():
             n = int(sum(len(p) for p in parts))
             self.nq[kind] = n
             q = max(n, 1)
@@ -396,6 +404,8 @@ class Continuum:
             a[kind + "rad"] = ti.ndarray(ti.f64, (q,))
             a[kind + "range"] = ti.ndarray(ti.i32, (max(len(ranges), 1), 2))
             a[kind + "edges"] = ti.ndarray(ti.i32, (ne, 2))
+            a[kind + "nbr"] = ti.ndarray(ti.i32, (q, 2))
+            a[kind + "nbr"].from_numpy(-np.ones((q, 2), np.int32))
             a[kind + "law"] = ti.ndarray(ti.f64, (max(len(laws), 1), pe.LAW_WIDTH))
             a[kind + "sedge"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
             a[kind + "sforce"] = _arr(2, (q, pe.SLOTS))
@@ -407,6 +417,7 @@ class Continuum:
                 a[kind + "rad"].from_numpy(np.concatenate(rad))
                 a[kind + "range"].from_numpy(np.array(ranges, np.int32))
                 a[kind + "edges"].from_numpy(np.concatenate(edges).astype(np.int32))
+                a[kind + "nbr"].from_numpy(np.concatenate(nbr))
                 a[kind + "law"].from_numpy(np.array(laws, float))
 
     def _radius_of(self, ids):
@@ -521,11 +532,11 @@ class Continuum:
             if not self.has_pcmm:
                 a["xforce"].fill(0.0)
             pe.point_edge(e["pos"], e["vel"], a["prad"], a["npos"], a["nvel"], a["ppart"],
-                          a["pcpl"], a["prange"], a["pedges"], a["plaw"], a["psedge"],
+                          a["pcpl"], a["prange"], a["pedges"], a["pnbr"], a["plaw"], a["psedge"],
                           a["psforce"], a["psbroken"], a["xforce"], a["nforce"], float(dt))
         if self.nq["v"]:
             pe.point_edge(a["npos"], a["nvel"], a["vrad"], a["npos"], a["nvel"], a["vpart"],
-                          a["vcpl"], a["vrange"], a["vedges"], a["vlaw"], a["vsedge"],
+                          a["vcpl"], a["vrange"], a["vedges"], a["vnbr"], a["vlaw"], a["vsedge"],
                           a["vsforce"], a["vsbroken"], a["nforce"], a["nforce"], float(dt))
 
         for kind, vel, force in (("p", e.get("vel"), a["xforce"]), ("v", a["nvel"], a["nforce"])):
