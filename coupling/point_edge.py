@@ -43,6 +43,14 @@ block sitting corner over corner on another is held by the corner pairs of both
 blocks, and a sideways jiggle of a few µm does not drop all of them at once and
 restart their springs from zero (the stack would ratchet down at each jiggle).
 
+Broad phase: every step the boundary edges of the coupled blocks are binned into a
+uniform grid over their bounding box (:func:`bin_edges`; an edge goes into every cell
+its bounding box, widened by the largest reach of a point — R of a particle, the
+vertex depth of a vertex — overlaps), and each point tests only the edges of its own
+cell. A point outside the grid touches no edge. The grid has at most ``GRID`` cells
+a side (cell side ≥ twice the reach), the cell lists are sorted by edge index, so
+that the result does not depend on the thread count.
+
 A new contact starts with F_n = F_s = 0 (the springs are incremental); a contact
 that slides over a node onto the adjacent edge keeps its force (turned into the
 new edge's frame); a contact whose point leaves the edges is forgotten. Each coupled particle keeps up to
@@ -56,6 +64,9 @@ from physics.validate import in_range, non_negative, positive
 
 SLOTS = 4
 VERTEX_DEPTH = 0.05   # deepest vertex–edge penetration taken as a contact, × A
+GRID = 64             # most cells per side of the broad-phase grid
+G_X0, G_Y0, G_H, G_NX, G_NY, G_X1, G_Y1 = 0, 1, 2, 3, 4, 5, 6   # gpar entries
+GPAR_SIZE = 8
 VERTEX_ENTRANCE = 0.1  # entrance rule tolerance: sine of the angle a vertex's own edge may dip
 VERTEX_END = 1e-3      # a vertex meets an edge up to this fraction of its length past its ends
 # columns of the law table (one row per couple)
@@ -107,7 +118,9 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
                cnbr: ti.types.ndarray(),
                claw: ti.types.ndarray(), sedge: ti.types.ndarray(),
                sforce: ti.types.ndarray(), sbroken: ti.types.ndarray(),
-               xforce: ti.types.ndarray(), nforce: ti.types.ndarray(), dt: ti.f64):
+               xforce: ti.types.ndarray(), nforce: ti.types.ndarray(),
+               gpar: ti.types.ndarray(), gcnt: ti.types.ndarray(),
+               gedge: ti.types.ndarray(), dt: ti.f64):
     """Contacts of every coupled row q (point cpart[q] of ``pos``/``vel`` with the
     edges crange[ccpl[q]] of a block): forces added to ``xforce`` (the points) and
     ``nforce`` (the edges' nodes). Slots: sedge (edge or −1), sforce (F_n, F_s),
@@ -116,7 +129,9 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
     crad[q] > 0: a particle of that radius (contact while |d| < R, A = 2R);
     crad[q] = −A < 0: a block vertex of tributary length A (vertex–edge contact
     while it has crossed the edge, −0.05·A < d < 0, and could have entered through
-    it: cnbr[q] are its two neighbours on its block's boundary, in ``pos``)."""
+    it: cnbr[q] are its two neighbours on its block's boundary, in ``pos``).
+    gpar, gcnt, gedge: the broad-phase grid of :func:`bin_edges`."""
+    gcap = gedge.shape[1]
     for q in range(cpart.shape[0]):
         p = cpart[q]
         c = ccpl[q]
@@ -133,10 +148,26 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
         cnt = 0
         ftot = ti.Vector([0.0, 0.0])
         best = -1
+        # the cell of the point in the broad-phase grid (−1: outside, no edge near)
+        cell = -1
+        h = gpar[G_H]
+        gx = ti.cast(ti.floor((x[0] - gpar[G_X0]) / h), ti.i32)
+        gy = ti.cast(ti.floor((x[1] - gpar[G_Y0]) / h), ti.i32)
+        nx = ti.cast(gpar[G_NX], ti.i32)
+        if gx >= 0 and gy >= 0 and gx < nx and gy < ti.cast(gpar[G_NY], ti.i32):
+            cell = gy * nx + gx
+        ncand = 0
+        if cell >= 0:
+            ncand = ti.min(gcnt[cell], gcap)
+        e_lo = crange[c, 0]
+        e_hi = crange[c, 1]
         if R < 0.0:
             # a vertex meets one edge of a block: the one it has crossed least
             dbest = 1e300
-            for e in range(crange[c, 0], crange[c, 1]):
+            for kc in range(ncand):
+                e = gedge[cell, kc]
+                if e < e_lo or e >= e_hi:
+                    continue
                 xi = npos[edges[e, 0]]
                 ev = npos[edges[e, 1]] - xi
                 L = ev.norm()
@@ -158,7 +189,10 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
                     if ok:
                         dbest = -d
                         best = e
-        for e in range(crange[c, 0], crange[c, 1]):
+        for kc in range(ncand):
+            e = gedge[cell, kc]
+            if e < e_lo or e >= e_hi:
+                continue
             a = edges[e, 0]
             b = edges[e, 1]
             xi = npos[a]
@@ -239,3 +273,73 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
             sbroken[q, k] = 0
         ti.atomic_add(xforce[p][0], ftot[0])
         ti.atomic_add(xforce[p][1], ftot[1])
+
+
+@ti.kernel
+def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64,
+              hmin: ti.f64, gpar: ti.types.ndarray(), gcnt: ti.types.ndarray(),
+              gedge: ti.types.ndarray(), need: ti.types.ndarray()):
+    """Broad phase (module docstring): the grid over the edges' bounding box widened
+    by ``reach`` (cell side max(hmin, extent/GRID)), and the edges of every cell,
+    sorted by index (gcnt[c] may exceed gedge's capacity: need[0] gets the largest
+    count, the caller grows the lists and bins again)."""
+    ne = edges.shape[0]
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        gpar[G_X0] = 1e300
+        gpar[G_Y0] = 1e300
+        gpar[G_X1] = -1e300
+        gpar[G_Y1] = -1e300
+        need[0] = 0
+    for e in range(ne):
+        for k in ti.static(range(2)):
+            x = npos[edges[e, k]]
+            ti.atomic_min(gpar[G_X0], x[0])
+            ti.atomic_min(gpar[G_Y0], x[1])
+            ti.atomic_max(gpar[G_X1], x[0])
+            ti.atomic_max(gpar[G_Y1], x[1])
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        x0 = gpar[G_X0] - reach
+        y0 = gpar[G_Y0] - reach
+        ext = ti.max(gpar[G_X1] + reach - x0, gpar[G_Y1] + reach - y0)
+        h = ti.max(hmin, ext / GRID) * (1.0 + 1e-9)
+        gpar[G_X0] = x0
+        gpar[G_Y0] = y0
+        gpar[G_H] = h
+        gpar[G_NX] = ti.cast(ti.min(ti.floor((gpar[G_X1] + reach - x0) / h) + 1, GRID), ti.f64)
+        gpar[G_NY] = ti.cast(ti.min(ti.floor((gpar[G_Y1] + reach - y0) / h) + 1, GRID), ti.f64)
+    for c in range(gcnt.shape[0]):
+        gcnt[c] = 0
+    cap = gedge.shape[1]
+    for e in range(ne):
+        xa = npos[edges[e, 0]]
+        xb = npos[edges[e, 1]]
+        h = gpar[G_H]
+        nx = ti.cast(gpar[G_NX], ti.i32)
+        ny = ti.cast(gpar[G_NY], ti.i32)
+        i0 = ti.max(ti.cast(ti.floor((ti.min(xa[0], xb[0]) - reach - gpar[G_X0]) / h), ti.i32), 0)
+        i1 = ti.min(ti.cast(ti.floor((ti.max(xa[0], xb[0]) + reach - gpar[G_X0]) / h), ti.i32),
+                    nx - 1)
+        j0 = ti.max(ti.cast(ti.floor((ti.min(xa[1], xb[1]) - reach - gpar[G_Y0]) / h), ti.i32), 0)
+        j1 = ti.min(ti.cast(ti.floor((ti.max(xa[1], xb[1]) + reach - gpar[G_Y0]) / h), ti.i32),
+                    ny - 1)
+        for j in range(j0, j1 + 1):
+            for i in range(i0, i1 + 1):
+                c = j * nx + i
+                k = ti.atomic_add(gcnt[c], 1)
+                if k < cap:
+                    gedge[c, k] = e
+    for c in range(gcnt.shape[0]):
+        m = gcnt[c]
+        if m > cap:
+            ti.atomic_max(need[0], m)
+            m = cap
+        # insertion sort by edge index: the same lists on any number of threads
+        for a in range(1, m):
+            v = gedge[c, a]
+            b = a
+            while b > 0 and gedge[c, b - 1] > v:
+                gedge[c, b] = gedge[c, b - 1]
+                b -= 1
+            gedge[c, b] = v

@@ -356,6 +356,7 @@ class Continuum:
         rows ("p" arrays) and block-vertex rows ("v" arrays: both ways for a pair of
         blocks) are kept apart: their points live in different arrays."""
         self.nq = {"p": 0, "v": 0}
+        self.reach = {"p": 0.0, "v": 0.0}
         rows = {"p": ([], [], [], [], [], [], []), "v": ([], [], [], [], [], [], [])}
         for ids, a, block, law, kn, ks in couples:
             if a is None:           # particles ids against block
@@ -411,6 +412,12 @@ class Continuum:
             a[kind + "sforce"] = _arr(2, (q, pe.SLOTS))
             a[kind + "sbroken"] = ti.ndarray(ti.i32, (q, pe.SLOTS))
             a[kind + "sedge"].from_numpy(-np.ones((q, pe.SLOTS), np.int32))
+            # broad-phase grid (coupling.point_edge.bin_edges)
+            a[kind + "gpar"] = ti.ndarray(ti.f64, (pe.GPAR_SIZE,))
+            a[kind + "gcnt"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID,))
+            a[kind + "gedge"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID, 16))
+            a[kind + "gneed"] = ti.ndarray(ti.i32, (1,))
+            self.reach[kind] = float(np.max(np.abs(np.concatenate(rad)))) if n else 0.0
             if n:
                 a[kind + "part"].from_numpy(np.concatenate(parts))
                 a[kind + "cpl"].from_numpy(np.concatenate(cpl))
@@ -531,13 +538,17 @@ class Continuum:
         if self.nq["p"]:
             if not self.has_pcmm:
                 a["xforce"].fill(0.0)
+            self._bin_edges("p")
             pe.point_edge(e["pos"], e["vel"], a["prad"], a["npos"], a["nvel"], a["ppart"],
                           a["pcpl"], a["prange"], a["pedges"], a["pnbr"], a["plaw"], a["psedge"],
-                          a["psforce"], a["psbroken"], a["xforce"], a["nforce"], float(dt))
+                          a["psforce"], a["psbroken"], a["xforce"], a["nforce"],
+                          a["pgpar"], a["pgcnt"], a["pgedge"], float(dt))
         if self.nq["v"]:
+            self._bin_edges("v")
             pe.point_edge(a["npos"], a["nvel"], a["vrad"], a["npos"], a["nvel"], a["vpart"],
                           a["vcpl"], a["vrange"], a["vedges"], a["vnbr"], a["vlaw"], a["vsedge"],
-                          a["vsforce"], a["vsbroken"], a["nforce"], a["nforce"], float(dt))
+                          a["vsforce"], a["vsbroken"], a["nforce"], a["nforce"],
+                          a["vgpar"], a["vgcnt"], a["vgedge"], float(dt))
 
         for kind, vel, force in (("p", e.get("vel"), a["xforce"]), ("v", a["nvel"], a["nforce"])):
             nr = self.nr.get(kind, 0)
@@ -545,6 +556,20 @@ class Continuum:
                 if kind == "p" and not self.has_pcmm and not self.nq["p"]:
                     a["xforce"].fill(0.0)
                 viscous_boundary(vel, force, a["nr" + kind + "ids"], a["nr" + kind + "coef"])
+
+    def _bin_edges(self, kind):
+        """The broad-phase grid of the edges of ``kind``'s couples, its cell lists
+        grown until every cell's edges fit."""
+        a = self.a
+        r = self.reach[kind]
+        while True:
+            pe.bin_edges(a["npos"], a[kind + "edges"], r, 2.0 * r, a[kind + "gpar"],
+                         a[kind + "gcnt"], a[kind + "gedge"], a[kind + "gneed"])
+            need = int(a[kind + "gneed"].to_numpy()[0])
+            if need <= a[kind + "gedge"].shape[1]:
+                return
+            a[kind + "gedge"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID,
+                                                    1 << int(need).bit_length()))
 
     def set_non_reflecting(self, kind, ids, coef):
         """Rows of the viscous boundary: ``kind`` "p" (particles) or "v" (block nodes)."""
