@@ -904,22 +904,25 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 q = bulk_viscosity(matp, M, de, dt, area)
                 ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64),
                                        area / cover, q * (de[0] + de[1])])
-                if kind != JWL_TYPE:
+                if not _has_eos(matp, M):
                     sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
                     fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
                     efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
     if ti.static(jwl):
-        # 2j. JWL particles: the equation of state at x_n. A particle's volume changes
-        #     by a third of Σ_e (S_e/N_e) Δθ_e over its elements (so that Σ_i p_i ΔVol_i
-        #     is the elements' pressure work exactly), its energy by −(p + q) ΔVol with
-        #     the p its elements pushed with over that change (last step's, so that the
-        #     energy lost is exactly the work the forces did); p = F·p_JWL(V, E) with F
-        #     the programmed burn fraction.
+        # 2j. particles with an equation of state (JWL, or a Fluid with
+        #     ``equation_of_state``; ``jwl`` is set whenever there are any): the state
+        #     at x_n. A particle's volume changes by a third of Σ_e (S_e/N_e) Δθ_e over
+        #     its elements (so that Σ_i p_i ΔVol_i is the elements' pressure work
+        #     exactly). JWL: its energy changes by −(p + q) ΔVol with the p its
+        #     elements pushed with over that change (last step's, so that the energy
+        #     lost is exactly the work the forces did), p = F·p_JWL(V, E) with F the
+        #     programmed burn fraction. Fluid: p(V) of :class:`physics.materials.Fluid`
+        #     (a state function: deleting or creating elements does not change it).
         ti.loop_config(serialize=serial)
         for i in range(n):
             M = pmat[i]
             if M >= 0:
-                if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                if _has_eos(matp, M):
                     thsum = 0.0
                     qsum = 0.0
                     for k in range(icnt[i]):
@@ -931,63 +934,25 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                         thsum += mw * d[5] * (d[0] + d[1])
                         qsum += mw * d[5] * d[6]
                     js = pjwl[i]
-                    F = 0.0
-                    if time >= js[2]:
-                        F = ti.min(1.0, (time - js[2]) * matp[M, 10] / (3.0 * rad[i]))
                     V0 = js[4]
                     V = js[0] + thsum / (3.0 * V0)
-                    E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
-                    p = F * jwl_pressure(matp, M, V, E)
-                    pjwl[i] = ti.Vector([V, E, js[2], p, V0])
-        # 2k. JWL elements: the mean pressure of their particles, and q
-        ti.loop_config(serialize=serial)
-        for a in range(n):
-            for s in range(ecnt[a]):
-                if emult[a, s] > 0:
-                    M = pmat[a]
                     if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
-                        b = elem[a, s, 0]
-                        c = elem[a, s, 1]
-                        pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
-                        sig = ti.Vector([-pm, -pm, 0.0, -pm])
-                        esig[a, s] = sig
-                        d = ede[a, s]
-                        q = 0.0
-                        if d[0] + d[1] < 0.0:
-                            q = d[6] / (d[0] + d[1])
-                        sf = sig + ti.Vector([-q, -q, 0.0, 0.0])
-                        fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
-                        efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
-    if ti.static(jwl):
-        # 2f. Fluid particles with ``equation_of_state`` (column 4 = 1; ``jwl`` is set
-        #     whenever particles carry an equation of state: JWL or such a Fluid): the
-        #     relative volume V of each particle changes by a
-        #     third of Σ_e (S_e/N_e) Δθ_e over its elements, as for JWL, and its
-        #     pressure is the equation of state p(V) of :class:`physics.materials.Fluid`
-        #     (a state function: deleting or creating elements does not change it).
-        ti.loop_config(serialize=serial)
-        for i in range(n):
-            M = pmat[i]
-            if M >= 0:
-                if ti.cast(matp[M, 0], ti.i32) == FLUID and matp[M, 4] > 0.0:
-                    thsum = 0.0
-                    for k in range(icnt[i]):
-                        code = inc[i, k]
-                        o = code >> 4
-                        sl = code & 15
-                        d = ede[o, sl]
-                        thsum += ti.cast(emult[o, sl], ti.f64) * d[5] * (d[0] + d[1])
-                    js = pjwl[i]
-                    V = js[0] + thsum / (3.0 * js[4])
-                    pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), js[4]])
-        # 2g. Fluid elements: the mean pressure of their particles, the viscous stress
-        #     2μ·dev(D) and the artificial bulk viscosity q (forces only)
+                        F = 0.0
+                        if time >= js[2]:
+                            F = ti.min(1.0, (time - js[2]) * matp[M, 10] / (3.0 * rad[i]))
+                        E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
+                        p = F * jwl_pressure(matp, M, V, E)
+                        pjwl[i] = ti.Vector([V, E, js[2], p, V0])
+                    else:
+                        pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), V0])
+        # 2k. their elements: the mean pressure of their particles, the viscous stress
+        #     2μ·dev(D) (Fluid) and the artificial bulk viscosity q (forces only)
         ti.loop_config(serialize=serial)
         for a in range(n):
             for s in range(ecnt[a]):
                 if emult[a, s] > 0:
                     M = pmat[a]
-                    if ti.cast(matp[M, 0], ti.i32) == FLUID and matp[M, 4] > 0.0:
+                    if _has_eos(matp, M):
                         b = elem[a, s, 0]
                         c = elem[a, s, 1]
                         pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
@@ -1082,10 +1047,7 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 psig[i] = ti.Vector([0.0, 0.0, 0.0, 0.0])
             M = pmat[i]
             if ti.static(jwl):
-                if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
-                    p = pjwl[i][3]
-                    psig[i] = ti.Vector([-p, -p, 0.0, -p])
-                elif ti.cast(matp[M, 0], ti.i32) == FLUID and matp[M, 4] > 0.0:
+                if _has_eos(matp, M):
                     p = pjwl[i][3]
                     psig[i] = ti.Vector([-p, -p, 0.0, -p])
             if hit == 1:
@@ -1111,6 +1073,14 @@ def bulk_viscosity(matp: ti.template(), M, de, dt, area):
         c = ti.sqrt((matp[M, 2] + 4.0 * matp[M, 3] / 3.0) / rho)
         q = rho * L * rate * (b1 * c + b2 * L * rate)
     return q
+
+
+@ti.func
+def _has_eos(matp: ti.template(), M):
+    """Whether material row M keeps its pressure per particle: JWL, or a Fluid with
+    ``equation_of_state`` (column 4 = 1)."""
+    kind = ti.cast(matp[M, 0], ti.i32)
+    return kind == JWL_TYPE or (kind == FLUID and matp[M, 4] > 0.0)
 
 
 @ti.func
