@@ -415,7 +415,10 @@ class Continuum:
             # broad-phase grid (coupling.point_edge.bin_edges)
             a[kind + "gpar"] = ti.ndarray(ti.f64, (pe.GPAR_SIZE,))
             a[kind + "gcnt"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID,))
-            a[kind + "gedge"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID, 16))
+            # a cell holds at most every edge: with that many slots (few edges) the
+            # lists never overflow and the step needs no read-back
+            a[kind + "gedge"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID,
+                                                    min(max(ne, 1), 256)))
             a[kind + "gneed"] = ti.ndarray(ti.i32, (1,))
             self.reach[kind] = float(np.max(np.abs(np.concatenate(rad)))) if n else 0.0
             if n:
@@ -565,8 +568,11 @@ class Continuum:
         while True:
             pe.bin_edges(a["npos"], a[kind + "edges"], r, 2.0 * r, a[kind + "gpar"],
                          a[kind + "gcnt"], a[kind + "gedge"], a[kind + "gneed"])
+            cap = a[kind + "gedge"].shape[1]
+            if cap >= a[kind + "edges"].shape[0]:
+                return
             need = int(a[kind + "gneed"].to_numpy()[0])
-            if need <= a[kind + "gedge"].shape[1]:
+            if need <= cap:
                 return
             a[kind + "gedge"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID,
                                                     1 << int(need).bit_length()))
