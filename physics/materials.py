@@ -495,16 +495,27 @@ def _solve_active(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2):
     """Multipliers Δγ (vector, unused slots 0) and corrected principals for the
     active planes act[0:nact]: Σ_c (n_b·D m_c) Δγ_c = F_b(p) for every active b.
     Returns (ok, Δγ, principals); ok = 0 when the planes are dependent."""
+    n0, k0, m0 = _plane(act[0], nphi, npsi, sq, coh, ten)
+    n1, k1, m1 = _plane(act[1], nphi, npsi, sq, coh, ten)
+    n2, k2, m2 = _plane(act[2], nphi, npsi, sq, coh, ten)
+    d0 = _dmul(m0, a1, a2)
+    d1 = _dmul(m1, a1, a2)
+    d2 = _dmul(m2, a1, a2)
     A = ti.Matrix.identity(ti.f64, 3)
-    r = ti.Vector([0.0, 0.0, 0.0])
-    for b in ti.static(range(3)):
-        if b < nact:
-            nb, kb, mb = _plane(act[b], nphi, npsi, sq, coh, ten)
-            r[b] = nb.dot(p) + kb
-            for c in ti.static(range(3)):
-                if c < nact:
-                    nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
-                    A[b, c] = nb.dot(_dmul(mc, a1, a2))
+    r = ti.Vector([n0.dot(p) + k0, 0.0, 0.0])
+    A[0, 0] = n0.dot(d0)
+    if nact >= 2:
+        r[1] = n1.dot(p) + k1
+        A[0, 1] = n0.dot(d1)
+        A[1, 0] = n1.dot(d0)
+        A[1, 1] = n1.dot(d1)
+    if nact == 3:
+        r[2] = n2.dot(p) + k2
+        A[0, 2] = n0.dot(d2)
+        A[1, 2] = n1.dot(d2)
+        A[2, 0] = n2.dot(d0)
+        A[2, 1] = n2.dot(d1)
+        A[2, 2] = n2.dot(d2)
     g = ti.Vector([0.0, 0.0, 0.0])
     # a set of dependent planes (singular matrix, relative to its row sizes) fails
     size = 1.0
@@ -518,11 +529,11 @@ def _solve_active(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2):
             g[0] = r[0] / A[0, 0]
         else:
             g = A.inverse() @ r
-    q = p
-    for c in ti.static(range(3)):
-        if c < nact:
-            nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
-            q -= g[c] * _dmul(mc, a1, a2)
+    q = p - g[0] * d0
+    if nact >= 2:
+        q -= g[1] * d1
+    if nact == 3:
+        q -= g[2] * d2
     return ok, g, q
 
 
@@ -534,12 +545,93 @@ def _try(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2, tol):
     for c in ti.static(range(3)):
         if c < nact and g[c] < 0.0:
             ok = 0
-    if ok == 1:
-        for k in range(9):
-            nk, ck, mk = _plane(k, nphi, npsi, sq, coh, ten)
-            if nk.dot(q) + ck > tol:
-                ok = 0
+    if ok == 1 and not _admissible(q, nphi, sq, coh, ten, tol):
+        ok = 0
     return ok, g, q
+
+
+@ti.func
+def _admissible(q, nphi, sq, coh, ten, tol):
+    """Whether principal values q violate none of the nine planes by more than tol:
+    the tension planes bind at the largest value, the shear planes at the pair
+    (largest, smallest) (i ≠ j: when all three are equal any pair gives the same)."""
+    smax = ti.max(q[0], ti.max(q[1], q[2]))
+    smin = ti.min(q[0], ti.min(q[1], q[2]))
+    return smax - ten <= tol and nphi * smax - smin - 2.0 * coh * sq <= tol
+
+
+@ti.func
+def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
+    """The first admissible active set (all Δγ ≥ 0, no plane violated by more than
+    tol) in the order: one plane (0–8), two planes, three planes, each
+    lexicographically; the planes' gradients n_k, D m_k and values F_k(p) are
+    tabulated once. Returns (ok, act, nact, Δγ, principals) as :func:`_try` gives
+    them for that set."""
+    N = ti.Matrix.zero(ti.f64, 9, 3)
+    Dm = ti.Matrix.zero(ti.f64, 9, 3)
+    F = ti.Vector.zero(ti.f64, 9)
+    for k in ti.static(range(9)):
+        nk, ck, mk = _plane(k, nphi, npsi, sq, coh, ten)
+        dk = _dmul(mk, a1, a2)
+        for j in ti.static(range(3)):
+            N[k, j] = nk[j]
+            Dm[k, j] = dk[j]
+        F[k] = nk.dot(p) + ck
+    ok = 0
+    act = ti.Vector([0, 0, 0])
+    nact = 1
+    g = ti.Vector([0.0, 0.0, 0.0])
+    q = p
+    for a in range(9):
+        if ok == 0:
+            da = ti.Vector([Dm[a, 0], Dm[a, 1], Dm[a, 2]])
+            A = N[a, 0] * da[0] + N[a, 1] * da[1] + N[a, 2] * da[2]
+            if A != 0.0:
+                ga = F[a] / A
+                if ga >= 0.0:
+                    qa = p - ga * da
+                    if _admissible(qa, nphi, sq, coh, ten, tol):
+                        ok = 1
+                        act = ti.Vector([a, 0, 0])
+                        g = ti.Vector([ga, 0.0, 0.0])
+                        q = qa
+    for a in range(9):
+        for b in range(a + 1, 9):
+            if ok == 0:
+                na = ti.Vector([N[a, 0], N[a, 1], N[a, 2]])
+                nb = ti.Vector([N[b, 0], N[b, 1], N[b, 2]])
+                da = ti.Vector([Dm[a, 0], Dm[a, 1], Dm[a, 2]])
+                db = ti.Vector([Dm[b, 0], Dm[b, 1], Dm[b, 2]])
+                A00 = na.dot(da)
+                A01 = na.dot(db)
+                A10 = nb.dot(da)
+                A11 = nb.dot(db)
+                det = A00 * A11 - A01 * A10
+                size = (ti.abs(A00) + ti.abs(A01)) * (ti.abs(A10) + ti.abs(A11))
+                if ti.abs(det) > 1e-10 * size:
+                    g0 = (A11 * F[a] - A01 * F[b]) / det
+                    g1 = (A00 * F[b] - A10 * F[a]) / det
+                    if g0 >= 0.0 and g1 >= 0.0:
+                        qa = p - g0 * da - g1 * db
+                        if _admissible(qa, nphi, sq, coh, ten, tol):
+                            ok = 1
+                            act = ti.Vector([a, b, 0])
+                            nact = 2
+                            g = ti.Vector([g0, g1, 0.0])
+                            q = qa
+    for a in range(9):
+        for b in range(a + 1, 9):
+            for c in range(b + 1, 9):
+                if ok == 0:
+                    st = ti.Vector([a, b, c])
+                    ok3, g3, q3 = _try(p, st, 3, nphi, npsi, sq, coh, ten, a1, a2, tol)
+                    if ok3 == 1:
+                        ok = 1
+                        act = st
+                        nact = 3
+                        g = g3
+                        q = q3
+    return ok, act, nact, g, q
 
 
 @ti.func
@@ -615,23 +707,8 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
                 act0 = act
                 g0 = g
                 q0 = q
-                for size in range(1, 4):
-                    for ka in range(9):
-                        for kb in range(9):
-                            for kc in range(9):
-                                if ok == 0:
-                                    use = 0
-                                    if size == 1 and kb == 0 and kc == 0:
-                                        use = 1
-                                    elif size == 2 and kb > ka and kc == 0:
-                                        use = 1
-                                    elif size == 3 and kb > ka and kc > kb:
-                                        use = 1
-                                    if use == 1:
-                                        act = ti.Vector([ka, kb, kc])
-                                        nact = size
-                                        ok, g, q = _try(p, act, nact, nphi, npsi, sq, coh,
-                                                        ten, a1, a2, tol)
+                ok, act, nact, g, q = _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2,
+                                                        tol)
                 if ok == 0:          # none found (not expected): keep FLAC's return
                     act = act0
                     nact = 1

@@ -52,6 +52,25 @@ Masses (Eq. 5)
 M_i = Σ_{e ∋ i} ρ·S_e/(3·N_e) over the elements containing i; a particle in no
 element gets ρ·π·R_i². Σ_i M_i = ρ·Σ_e S_e/N_e.
 
+Rebuilt where something can have changed
+-----------------------------------------
+Inside a simulation (:func:`update`) the element set, N_e and the bookkeeping
+that follows from them are recomputed only where they can have changed, and the
+set stays exactly the one the rules give. Every answer a rule gives has a slack:
+the distance each particle involved may move before the answer can change (a
+distance against its cut-off: half the margin; an angle: the turn of the arms,
+``_angle_slack``; the sign of an orientation or of a probe against an edge: the
+exact bound of the change of a cross product, ``_orient_slack``). A particle's
+Eq. 1 list, ring and elements depend on it and its candidates only; N_e of an
+element on its vertices' Eq. 1 neighbourhoods. The rules are unchanged by a
+translation, so what is tracked is each particle's displacement u since the
+epoch began *relative to the particle whose rules they are*: with u measured from
+the epoch's start, a particle built when the largest relative u around it was W
+keeps its elements while the largest relative u around it stays below
+slack − W. An epoch begins at the first steps, after a restore, when the engine
+rebuilds its neighbour lists (the candidates change) and after a step that had to
+rebuild many particles or recount many N_e (the slack left shrinks as the u grow).
+
 Arrays
 ------
 Everything lives in ``ti.ndarray`` objects passed to the module-level kernels
@@ -111,11 +130,16 @@ def _angle_ok(p, q, r):
 def _ring(i, xi, m, pos: ti.template(), nbr: ti.template(), ring: ti.template(),
           ring_ang: ti.template()):
     """Counter-clockwise ring of the m neighbours nbr[i, :m] of particle i (at xi),
-    angularly pruned (module docstring); returns the number left in ring[i, :]."""
+    angularly pruned (module docstring); returns the number left in ring[i, :] and
+    the ring's slack: a displacement (m) such that the same ring results while no
+    particle involved moves farther than it (:func:`_angle_slack`, :func:`_dist_slack`
+    of every comparison the sort and the pruning made)."""
     # counter-clockwise ring: insertion sort by (angle, index)
+    dmin = 1e300
     for a in range(m):
         j = nbr[i, a]
         d = pos[j] - xi
+        dmin = ti.min(dmin, d.norm())
         ang = ti.math.atan2(d[1], d[0])
         b = a
         while b > 0 and ring_ang[i, b - 1] > ang:
@@ -124,10 +148,22 @@ def _ring(i, xi, m, pos: ti.template(), nbr: ti.template(), ring: ti.template(),
             b -= 1
         ring[i, b] = j
         ring_ang[i, b] = ang
+    # the cyclic order holds while every adjacent gap keeps its sign
+    amar = 2.0 * math.pi
+    dmar = 1e300
+    if m >= 2:
+        for k in range(m):
+            g = 0.0
+            if k + 1 < m:
+                g = ring_ang[i, k + 1] - ring_ang[i, k]
+            else:
+                g = ring_ang[i, 0] + 2.0 * math.pi - ring_ang[i, k]
+            amar = ti.min(amar, g)
     # angular pruning: drop the farther of the closest adjacent pair while < 30 deg
     while m >= 2:
         kmin = 0
         gmin = 1e300
+        g2 = 1e300
         for k in range(m):
             g = 0.0
             if k + 1 < m:
@@ -135,10 +171,16 @@ def _ring(i, xi, m, pos: ti.template(), nbr: ti.template(), ring: ti.template(),
             else:
                 g = ring_ang[i, 0] + 2.0 * math.pi - ring_ang[i, k]
             if g < gmin:
+                g2 = gmin
                 gmin = g
                 kmin = k
+            elif g < g2:
+                g2 = g
+        amar = ti.min(amar, ti.abs(gmin - MIN_GAP))
         if gmin >= MIN_GAP:
             break
+        if m > 2:
+            amar = ti.min(amar, g2 - gmin)
         k1 = (kmin + 1) % m
         ja = ring[i, kmin]
         jb = ring[i, k1]
@@ -146,6 +188,7 @@ def _ring(i, xi, m, pos: ti.template(), nbr: ti.template(), ring: ti.template(),
         db = pos[jb] - xi
         qa = da.dot(da)
         qb = db.dot(db)
+        dmar = ti.min(dmar, 0.25 * ti.abs(ti.sqrt(qa) - ti.sqrt(qb)))
         drop = kmin
         if qb > qa or (qb == qa and jb > ja):
             drop = k1
@@ -153,15 +196,74 @@ def _ring(i, xi, m, pos: ti.template(), nbr: ti.template(), ring: ti.template(),
             ring[i, k] = ring[i, k + 1]
             ring_ang[i, k] = ring_ang[i, k + 1]
         m -= 1
-    return m
+    # a gap is a difference of two directions seen from i (each turns by at most
+    # asin(2Δ/d)), a comparison of two gaps a difference of four
+    slack = ti.min(dmar, _angle_slack(0.5 * amar, dmin))
+    return m, slack
+
+
+@ti.func
+def _dist_slack(d, cut):
+    """How far (m) each of two particles d apart may move before d crosses cut."""
+    return 0.5 * ti.abs(d - cut)
+
+
+@ti.func
+def _angle_slack(theta, arm):
+    """How far (m) the vertex and the ends of two arms at least ``arm`` long may move
+    before the angle between the arms has changed by theta (each arm's direction
+    turns by at most asin(2Δ/arm))."""
+    return 0.5 * arm * ti.sin(0.5 * ti.min(theta, math.pi))
+
+
+@ti.func
+def _orient_slack(a, b, p):
+    """How far (m) each of a, b and p may move before the sign of
+    :func:`_orient` (a, b, p) can change: the largest Δ with
+    4Δ² + 2Δ(|b − a| + |p − a|) < |orient| (the exact bound of the change of the
+    cross product (b − a) × (p − a) when each point moves by at most Δ)."""
+    S = (b - a).norm() + (p - a).norm()
+    o = ti.abs(_orient(a, b, p))
+    return 0.25 * (ti.sqrt(S * S + 4.0 * o) - S)
+
+
+@ti.func
+def _join(ok, slack, c, cslack):
+    """The value and slack of (ok and c): all true, the smallest slack of them; else
+    the largest slack of the false ones."""
+    out = slack
+    if ok and c:
+        out = ti.min(slack, cslack)
+    elif ok and not c:
+        out = cslack
+    elif (not ok) and not c:
+        out = ti.max(slack, cslack)
+    return ok and c, out
+
+
+@ti.func
+def _angle_ok_slack(p, q, r):
+    """Eq. 2 at vertex p of the triangle (p, q, r) (:func:`_angle_ok`) and its slack:
+    how far (m) the three may move before the answer can change."""
+    u = q - p
+    v = r - p
+    lu = u.norm()
+    lv = v.norm()
+    cth = ti.math.clamp(u.dot(v) / (lu * lv), -1.0, 1.0)
+    th = ti.acos(cth)
+    margin = ti.min(ti.abs(th - math.pi / 6.0), ti.abs(th - 5.0 * math.pi / 6.0))
+    return _angle_ok(p, q, r), _angle_slack(margin, ti.min(lu, lv))
 
 
 @ti.func
 def _create(a, m, xa, ra, tol, pos: ti.template(), rad: ti.template(), ring: ti.template(),
             elem: ti.template(), earea: ti.template()):
     """Elements of particle a (at xa, radius ra) from its ring of m neighbours, by the
-    creation rules; stored in elem[a, :], earea[a, :]; returns their number."""
+    creation rules; stored in elem[a, :], earea[a, :]; returns their number and the
+    slack of the rules (how far, m, every particle involved may move before one of
+    the answers, created or not, can change)."""
     cnt = 0
+    slack = 1e300
     if m >= 2:
         for k in range(m):
             b = ring[a, k]
@@ -171,27 +273,35 @@ def _create(a, m, xa, ra, tol, pos: ti.template(), rad: ti.template(), ring: ti.
             rb = rad[b]
             rc = rad[c]
             twice = _orient(xa, xb, xc)
-            ab = xb - xa
-            bc = xc - xb
-            ca = xa - xc
-            lab = ab.dot(ab)
-            lbc = bc.dot(bc)
-            lca = ca.dot(ca)
+            lab = (xb - xa).norm()
+            lbc = (xc - xb).norm()
+            lca = (xa - xc).norm()
             cab = ra + rb + tol
             cbc = rb + rc + tol
             cca = rc + ra + tol
             emin = 0.5 * (ra + rb + rc) / 3.0
-            ok = twice > 0.0
-            ok = ok and lab <= cab * cab and lbc <= cbc * cbc and lca <= cca * cca
-            ok = ok and lab >= emin * emin and lbc >= emin * emin and lca >= emin * emin
-            ok = ok and _angle_ok(xa, xb, xc) and _angle_ok(xb, xc, xa) and _angle_ok(
-                xc, xa, xb)
+            ok = True
+            sl = 1e300
+            ok, sl = _join(ok, sl, twice > 0.0, _orient_slack(xa, xb, xc))
+            ok, sl = _join(ok, sl, lab <= cab, _dist_slack(lab, cab))
+            ok, sl = _join(ok, sl, lbc <= cbc, _dist_slack(lbc, cbc))
+            ok, sl = _join(ok, sl, lca <= cca, _dist_slack(lca, cca))
+            ok, sl = _join(ok, sl, lab >= emin, _dist_slack(lab, emin))
+            ok, sl = _join(ok, sl, lbc >= emin, _dist_slack(lbc, emin))
+            ok, sl = _join(ok, sl, lca >= emin, _dist_slack(lca, emin))
+            c1, s1 = _angle_ok_slack(xa, xb, xc)
+            ok, sl = _join(ok, sl, c1, s1)
+            c2, s2 = _angle_ok_slack(xb, xc, xa)
+            ok, sl = _join(ok, sl, c2, s2)
+            c3, s3 = _angle_ok_slack(xc, xa, xb)
+            ok, sl = _join(ok, sl, c3, s3)
+            slack = ti.min(slack, sl)
             if ok and cnt < MAX_ELEMENTS:
                 elem[a, cnt, 0] = b
                 elem[a, cnt, 1] = c
                 earea[a, cnt] = 0.5 * twice
                 cnt += 1
-    return cnt
+    return cnt, slack
 
 
 @ti.func
@@ -319,7 +429,7 @@ def find_neighbours(pos: ti.types.ndarray(), rad: ti.types.ndarray(), tol: ti.f6
         nbr_cnt[i] = m
         for k in range(m, cap):
             nbr[i, k] = -1
-        m = _ring(i, xi, m, pos, nbr, ring, ring_ang)
+        m, _ = _ring(i, xi, m, pos, nbr, ring, ring_ang)
         ring_cnt[i] = m
         for k in range(m, cap):
             ring[i, k] = -1
@@ -334,7 +444,7 @@ def create_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(), tol: ti.f6
     rules: elem[A, s, 0:2] = (i, i+1), earea[A, s] = area S_e, s < ecnt[A]."""
     n = pos.shape[0]
     for a in range(n):
-        cnt = _create(a, ring_cnt[a], pos[a], rad[a], tol, pos, rad, ring, elem, earea)
+        cnt, _ = _create(a, ring_cnt[a], pos[a], rad[a], tol, pos, rad, ring, elem, earea)
         ecnt[a] = cnt
         for s in range(cnt, MAX_ELEMENTS):
             elem[a, s, 0] = -1
@@ -639,7 +749,14 @@ def check_rules(positions, radii, tolerance, triangles, rtol=1e-9):
 P_NEED = 0       # largest number of Eq. 1 candidates of any particle
 P_BUILDS = 1     # engine list build the candidates were made from (−1: none yet)
 P_INC = 2        # largest number of elements containing one particle
-PFLAGS_SIZE = 4
+P_EPOCH = 3      # the P_BUILDS value the current epoch began at (rebuild_elements)
+P_NEW = 4        # 1: this step begins an epoch
+P_REBUILT = 5    # particles that rebuilt their elements this step
+P_RECOUNT = 6    # elements whose N_e was recounted this step
+PFLAGS_SIZE = 8
+PFLAGS_INIT = (0, -1, 0, 0, 1, 0, 0, 0)
+EPOCH_REBUILT = 0.05   # a new epoch begins after a step that rebuilt this fraction
+EPOCH_RECOUNT = 0.10   # ... or recounted N_e of this many elements per particle
 FLUID_CORE = 0.75  # λ of fluid_core_force
 MAX_INCIDENT = 64  # slots of a particle's list of the elements containing it
 
@@ -698,16 +815,20 @@ def candidates(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.
 @ti.func
 def _cover_incident(v0, v1, v2, pos: ti.template(), elem: ti.template(),
                     inc: ti.template(), icnt: ti.template(), emult: ti.template()):
-    """:func:`_cover` from the lists of the elements containing each vertex."""
+    """:func:`_cover` from the lists of the elements containing each vertex, and its
+    slack: how far (m) every particle involved may move before one of the
+    inside/outside answers can change (:func:`_orient_slack` of the deciding edges:
+    all three for a probe inside, the farthest failing one for a probe outside)."""
     p = PROBE[0] * pos[v0] + PROBE[1] * pos[v1] + PROBE[2] * pos[v2]
     verts = ti.Vector([v0, v1, v2])
     count = 0
+    slack = 1e300
     for t in ti.static(range(3)):
         v = verts[t]
         for q in range(icnt[v]):
             code = inc[v, q]
-            o = code >> 4
-            s2 = code & 15
+            o = code >> 6
+            s2 = (code >> 2) & 15
             e1 = elem[o, s2, 0]
             e2 = elem[o, s2, 1]
             take = True
@@ -718,19 +839,25 @@ def _cover_incident(v0, v1, v2, pos: ti.template(), elem: ti.template(),
                 xo = pos[o]
                 x1 = pos[e1]
                 x2 = pos[e2]
-                if _orient(xo, x1, p) > 0.0 and _orient(x1, x2, p) > 0.0 and \
-                        _orient(x2, xo, p) > 0.0:
+                ok = True
+                sl = 1e300
+                ok, sl = _join(ok, sl, _orient(xo, x1, p) > 0.0, _orient_slack(xo, x1, p))
+                ok, sl = _join(ok, sl, _orient(x1, x2, p) > 0.0, _orient_slack(x1, x2, p))
+                ok, sl = _join(ok, sl, _orient(x2, xo, p) > 0.0, _orient_slack(x2, xo, p))
+                slack = ti.min(slack, sl)
+                if ok:
                     count += m
-    return count
+    return count, slack
 
 
 @ti.func
 def _creates(o, x, y, elem: ti.template(), ecnt: ti.template()):
-    """Whether particle o created the element (o, x, y) (same orientation)."""
-    found = False
+    """The slot in which particle o created the element (o, x, y) (same orientation),
+    −1 if it did not."""
+    found = -1
     for s in range(ecnt[o]):
         if elem[o, s, 0] == x and elem[o, s, 1] == y:
-            found = True
+            found = s
     return found
 
 
@@ -747,121 +874,285 @@ def _corner(o, e1, e2, i):
     return c
 
 
+SLACK_FLOOR = 1e-9   # relative to the radius: slack below this counts as none
+
+
 @ti.kernel
-def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarray(),
-           pmat: ti.types.ndarray(), matp: ti.types.ndarray(), mtol: ti.types.ndarray(),
-           cand: ti.types.ndarray(), ccnt: ti.types.ndarray(), nbr: ti.types.ndarray(),
-           ncnt: ti.types.ndarray(), ring: ti.types.ndarray(), rang: ti.types.ndarray(),
-           elem: ti.types.ndarray(), ecnt: ti.types.ndarray(), earea: ti.types.ndarray(),
-           ncov: ti.types.ndarray(), esig: ti.types.ndarray(), efor: ti.types.ndarray(),
-           ede: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
-           pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), enbr: ti.types.ndarray(),
-           encnt: ti.types.ndarray(), cskip: ti.types.ndarray(), inc: ti.types.ndarray(),
-           icnt: ti.types.ndarray(), emult: ti.types.ndarray(), pflags: ti.types.ndarray(),
-           elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
-           ecnt_old: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
-           time: ti.f64, first: ti.i32, carry: ti.template(), jwl: ti.template(),
-           serial: ti.template()):
-    """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16), for the particles of x_n
-    moving at v_{n−1/2}:
-
-    1. per particle: Eq. 1 neighbours from the candidates, pruned ring, elements
-       (the element set the rules give now: deleted and created in one go);
-    2. per element: N_e (probe rule), σ_old = mean of its particles' stresses,
-       Eqs. 6–11 with the Jaumann rotation (velocity gradient on the mid-step
-       configuration, see :mod:`physics.blocks`), the constitutive correction (Eq. 12),
-       nodal forces with the weight 1/N_e (Eqs. 13–14, sign fixed);
-    3. per particle (gathered, no atomics): force of its elements → xforce,
-       stress = mean of its elements' σ (zero in none), strain and plastic shear
-       strain += the means of the increments; the engine's pair slots (``cskip``):
-       1 for two particles that are corners of a common element (no DEM contact:
-       the element carries their interaction; the contact law records their
-       overlap, from which it counts when it takes over, see
-       :func:`tdem.step.pair_contact`), and for same-body Fluid or JWL neighbours
-       (:func:`fluid_core_force`); 2, at the first step only, for the other
-       same-body Eq. 1 neighbours (the contact law starts from their initial
-       overlap: a touching pair left out of the elements by the angular pruning
-       does not push apart). All other touching pairs — sharing no element,
-       whether in elements or not, same body or not — meet through the contact
-       law, so that particles cannot pass through each other.
-
-    pstate[i] = (plastic shear strain, failed (0/1), elements containing i, −).
-    """
+def displacements(pos: ti.types.ndarray(), pmat: ti.types.ndarray(),
+                  xref: ti.types.ndarray(), pu: ti.types.ndarray(),
+                  pflags: ti.types.ndarray(), full: ti.i32, serial: ti.template()):
+    """0. u_i = |x_i − x_ref,i|, the distance each particle has moved since the
+    epoch began. An epoch begins (x_ref = x, everything rebuilt) at the first step,
+    after a restore, whenever the candidates were rebuilt (the engine rebuilt its
+    lists) and after a step in which many particles rebuilt or many elements were
+    recounted (the slack left shrinks as the u grow: ``EPOCH_REBUILT``,
+    ``EPOCH_RECOUNT``)."""
     n = pos.shape[0]
-    # 1. neighbours, ring, elements
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        new = 0
+        if full != 0 or pflags[P_EPOCH] != pflags[P_BUILDS] or \
+                pflags[P_REBUILT] > EPOCH_REBUILT * n or pflags[P_RECOUNT] > EPOCH_RECOUNT * n:
+            new = 1
+        pflags[P_NEW] = new
+        pflags[P_EPOCH] = pflags[P_BUILDS]
+        pflags[P_REBUILT] = 0
+        pflags[P_RECOUNT] = 0
     ti.loop_config(serialize=serial)
     for i in range(n):
+        if pmat[i] >= 0:
+            if pflags[P_NEW] != 0:
+                xref[i] = pos[i]
+                pu[i] = ti.Vector([0.0, 0.0])
+            else:
+                pu[i] = pos[i] - xref[i]
+
+
+@ti.kernel
+def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
+                     pmat: ti.types.ndarray(), mtol: ti.types.ndarray(),
+                     cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
+                     nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
+                     ring: ti.types.ndarray(), rang: ti.types.ndarray(),
+                     elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+                     earea: ti.types.ndarray(), esig: ti.types.ndarray(),
+                     elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
+                     ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(),
+                     pu: ti.types.ndarray(), pbud: ti.types.ndarray(),
+                     prb: ti.types.ndarray(), pflags: ti.types.ndarray(), full: ti.i32,
+                     serial: ti.template()):
+    """1. The element set the rules give now, rebuilt only where it can have changed.
+
+    A particle's Eq. 1 list, ring and elements depend on the positions of the
+    particle and its candidates only. When they are built, every comparison the rules
+    made has a slack (the rules' ``_slack`` helpers): while no particle involved has
+    moved farther than it since, every answer is the same, and so is the element
+    set. With u the distances moved since the epoch began, a particle built when the
+    largest u around it was W keeps its elements while the largest u around it stays
+    below slack − W (``pbud``; |x(t) − x(t_b)| ≤ u(t) + u(t_b)); otherwise, and at the
+    start of an epoch, it rebuilds (``prb`` = 1). A rebuilt particle keeps its last
+    elements and their stresses in the ``_old`` arrays and points each new slot at
+    the old slot of the same element (``esrc``, −1 for a new one).
+    """
+    new = pflags[P_NEW] != 0
+    ti.loop_config(serialize=serial)
+    for i in range(pos.shape[0]):
         m = pmat[i]
-        cnt = 0
+        prb[i] = 0
         if m >= 0:
-            xi = pos[i]
-            ri = rad[i]
-            tol = mtol[m]
+            umax = 0.0
+            ui = pu[i]
             for q in range(ccnt[i]):
-                j = cand[i, q]
-                d = pos[j] - xi
-                cut = ri + rad[j] + tol
-                if d.dot(d) <= cut * cut:
-                    nbr[i, cnt] = j
-                    cnt += 1
-            ncnt[i] = cnt
-            if ti.static(carry):
-                # keep last step's elements of i and their stresses (every copy holds its
-                # triangle's stress, see 2b)
+                umax = ti.max(umax, (pu[cand[i, q]] - ui).norm())
+            if new or umax >= pbud[i]:
+                prb[i] = 1
+                if not new:
+                    ti.atomic_add(pflags[P_REBUILT], 1)
+                xi = pos[i]
+                ri = rad[i]
+                tol = mtol[m]
+                slack = 1e300
+                cnt = 0
+                for q in range(ccnt[i]):
+                    j = cand[i, q]
+                    d = (pos[j] - xi).norm()
+                    cut = ri + rad[j] + tol
+                    slack = ti.min(slack, _dist_slack(d, cut))
+                    if d <= cut:
+                        nbr[i, cnt] = j
+                        cnt += 1
+                ncnt[i] = cnt
                 ecnt_old[i] = ecnt[i]
                 for s in range(ecnt[i]):
                     elem_old[i, s, 0] = elem[i, s, 0]
                     elem_old[i, s, 1] = elem[i, s, 1]
                     esig_old[i, s] = esig[i, s]
-            r = _ring(i, xi, cnt, pos, nbr, ring, rang)
-            ecnt[i] = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
+                r, rs = _ring(i, xi, cnt, pos, nbr, ring, rang)
+                ne, cs = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
+                ecnt[i] = ne
+                for s in range(ne):
+                    src = -1
+                    for so in range(ecnt_old[i]):
+                        if elem_old[i, so, 0] == elem[i, s, 0] and \
+                                elem_old[i, so, 1] == elem[i, s, 1]:
+                            src = so
+                    esrc[i, s] = src
+                slack = ti.min(slack, ti.min(rs, cs))
+                pbud[i] = slack - umax - SLACK_FLOOR * ri
         else:
             ncnt[i] = 0
             ecnt[i] = 0
-    # 1b. copies: a triangle created by k of its vertices is computed once, by the
-    #     copy of the lowest-index creator, with multiplicity k (emult; 0 for the
-    #     other copies). Copies have the same N_e, stress and forces, so every sum
-    #     over elements below weights the computed copy by k.
+
+
+@ti.kernel
+def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
+               pu: ti.types.ndarray(), prb: ti.types.ndarray(), pdirty: ti.types.ndarray(),
+               unb: ti.types.ndarray(), serial: ti.template()):
+    """1a. ``pdirty``: the particle or one of its Eq. 1 neighbours rebuilt (every
+    vertex of an element containing i is one of them, so the multiplicities, the
+    copies and the list of elements containing i can only have changed there);
+    ``unb``: the largest u over the particle and its Eq. 1 neighbours."""
     ti.loop_config(serialize=serial)
-    for a in range(n):
-        for s in range(ecnt[a]):
-            b = elem[a, s, 0]
-            c = elem[a, s, 1]
-            mult = 1
-            if _creates(b, c, a, elem, ecnt):
-                mult = 0 if b < a else mult + 1
-            if mult > 0 and _creates(c, a, b, elem, ecnt):
-                mult = 0 if c < a else mult + 1
-            emult[a, s] = mult
-    # 1c. the computed elements containing each particle (owner << 4 | slot): the
-    #     owner is the particle or one of its Eq. 1 neighbours
-    ti.loop_config(serialize=serial)
-    for i in range(n):
-        cnt = 0
+    for i in range(pmat.shape[0]):
+        d = prb[i]
+        u = 0.0
         if pmat[i] >= 0:
-            for q in range(ncnt[i] + 1):
-                o = i
-                if q > 0:
-                    o = nbr[i, q - 1]
-                for s in range(ecnt[o]):
-                    if emult[o, s] > 0 and _corner(o, elem[o, s, 0], elem[o, s, 1], i) >= 0:
-                        if cnt < MAX_INCIDENT:
-                            inc[i, cnt] = (o << 4) | s
-                        cnt += 1
-            if cnt > MAX_INCIDENT:
-                ti.atomic_max(pflags[P_INC], cnt)
-                cnt = MAX_INCIDENT
-        icnt[i] = cnt
-    # 2. element stresses and nodal forces
+            ui = pu[i]
+            for q in range(ncnt[i]):
+                j = nbr[i, q]
+                d = ti.max(d, prb[j])
+                u = ti.max(u, (pu[j] - ui).norm())
+        pdirty[i] = d
+        unb[i] = u
+
+
+@ti.kernel
+def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+           emult: ti.types.ndarray(), ecopy: ti.types.ndarray(), pdirty: ti.types.ndarray(),
+           serial: ti.template()):
+    """1b. Copies: a triangle created by k of its vertices is computed once, by the
+    copy of the lowest-index creator, with multiplicity k (``emult``; 0 for the other
+    copies, whose ``ecopy`` = owner << 4 | slot of the computed copy). Copies have the
+    same N_e, stress and forces, so every sum over elements weights the computed copy
+    by k. Only where something changed (``pdirty``)."""
     ti.loop_config(serialize=serial)
-    for a in range(n):
+    for a in range(pmat.shape[0]):
+        if pdirty[a] != 0:
+            for s in range(ecnt[a]):
+                b = elem[a, s, 0]
+                c = elem[a, s, 1]
+                mult = 1
+                owner = a
+                slot = s
+                sb = _creates(b, c, a, elem, ecnt)
+                if sb >= 0:
+                    mult += 1
+                    if b < owner:
+                        owner = b
+                        slot = sb
+                sc = _creates(c, a, b, elem, ecnt)
+                if sc >= 0:
+                    mult += 1
+                    if c < owner:
+                        owner = c
+                        slot = sc
+                emult[a, s] = mult if owner == a else 0
+                ecopy[a, s] = (owner << 4) | slot
+
+
+@ti.kernel
+def incidence(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
+              elem: ti.types.ndarray(), ecnt: ti.types.ndarray(), emult: ti.types.ndarray(),
+              inc: ti.types.ndarray(), icnt: ti.types.ndarray(), pdirty: ti.types.ndarray(),
+              pflags: ti.types.ndarray(), serial: ti.template()):
+    """1c. The computed elements containing each particle (owner << 6 | slot << 2 |
+    which corner the particle is; the owner is the particle or one of its Eq. 1
+    neighbours), where something changed."""
+    ti.loop_config(serialize=serial)
+    for i in range(pmat.shape[0]):
+        if pdirty[i] != 0:
+            cnt = 0
+            if pmat[i] >= 0:
+                for q in range(ncnt[i] + 1):
+                    o = i
+                    if q > 0:
+                        o = nbr[i, q - 1]
+                    for s in range(ecnt[o]):
+                        if emult[o, s] > 0 and _corner(o, elem[o, s, 0], elem[o, s, 1], i) >= 0:
+                            if cnt < MAX_INCIDENT:
+                                inc[i, cnt] = (o << 6) | (s << 2) | _corner(
+                                    o, elem[o, s, 0], elem[o, s, 1], i)
+                            cnt += 1
+                if cnt > MAX_INCIDENT:
+                    ti.atomic_max(pflags[P_INC], cnt)
+                    cnt = MAX_INCIDENT
+            icnt[i] = cnt
+
+
+@ti.func
+def _record(fa, fb, fc, sig, de, eps, flag, mult):
+    """What the gather reads of a computed element, in one record (``efor``): the
+    nodal forces on its corners (0–5), its stress (6–9), strain increment (10–12),
+    plastic shear strain increment (13), failure flag (14), multiplicity (15)."""
+    return ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1], sig[0], sig[1], sig[2],
+                      sig[3], de[0], de[1], de[2], eps, flag, mult])
+
+
+@ti.func
+def _carried(a, b, c, s, elem: ti.template(), ecnt: ti.template(), esig: ti.template(),
+             elem_old: ti.template(), esig_old: ti.template(), ecnt_old: ti.template(),
+             esrc: ti.template(), prb: ti.template()):
+    """Last step's stress of the element (a, b, c) in a's slot s, if it existed: a's
+    own slot when a kept its elements, else the old slot ``esrc`` points at, else the
+    copy of b or c (their old lists when they rebuilt; a copy not computed this step
+    is not written by the stress pass, so reading it is safe). Returns (stress,
+    found)."""
+    out = ti.Vector([0.0, 0.0, 0.0, 0.0])
+    found = False
+    if prb[a] == 0:
+        out = esig[a, s]
+        found = True
+    elif esrc[a, s] >= 0:
+        out = esig_old[a, esrc[a, s]]
+        found = True
+    else:
+        for t in ti.static(range(1, 3)):
+            o, u, w = b, c, a
+            if ti.static(t == 2):
+                o, u, w = c, a, b
+            if not found:
+                if prb[o] != 0:
+                    for so in range(ecnt_old[o]):
+                        if elem_old[o, so, 0] == u and elem_old[o, so, 1] == w:
+                            out = esig_old[o, so]
+                            found = True
+                else:
+                    for so in range(ecnt[o]):
+                        if elem[o, so, 0] == u and elem[o, so, 1] == w:
+                            out = esig[o, so]
+                            found = True
+    return out, found
+
+
+@ti.kernel
+def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.ndarray(),
+             matp: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+             emult: ti.types.ndarray(), inc: ti.types.ndarray(), icnt: ti.types.ndarray(),
+             ncov: ti.types.ndarray(), ebud: ti.types.ndarray(), esig: ti.types.ndarray(),
+             efor: ti.types.ndarray(), ede: ti.types.ndarray(), psig: ti.types.ndarray(),
+             pstate: ti.types.ndarray(), rad: ti.types.ndarray(),
+             elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
+             ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(), prb: ti.types.ndarray(),
+             pdirty: ti.types.ndarray(), unb: ti.types.ndarray(), pu: ti.types.ndarray(),
+             pflags: ti.types.ndarray(), full: ti.i32, dt: ti.f64, carry: ti.template(),
+             eos: ti.template(), serial: ti.template()):
+    """2. Per computed element: N_e (probe rule; recounted where the elements around
+    it changed or its vertices' neighbourhoods moved farther than the count's slack,
+    ``ebud``, the same bookkeeping as :func:`rebuild_elements`), σ_old (the element's
+    own stress of last step if it existed and ``carry``, else the mean of its
+    particles' stresses), Eqs. 6–11 with the Jaumann rotation (velocity gradient on
+    the mid-step configuration, see :mod:`physics.blocks`), the constitutive
+    correction (Eq. 12), nodal forces with the weight 1/N_e (Eqs. 13–14, sign
+    fixed)."""
+    new = pflags[P_NEW] != 0
+    ti.loop_config(serialize=serial)
+    for a in range(pmat.shape[0]):
         for s in range(ecnt[a]):
             if emult[a, s] > 0:
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
                 v0, v1, v2 = _sorted3(a, b, c)
-                cover = _cover_incident(v0, v1, v2, pos, elem, inc, icnt, emult)
-                ncov[a, s] = cover
+                u0 = pu[v0]
+                uw = ti.max(unb[v0], ti.max(unb[v1] + (pu[v1] - u0).norm(),
+                                            unb[v2] + (pu[v2] - u0).norm()))
+                cover = ncov[a, s]
+                if new or pdirty[v0] + pdirty[v1] + pdirty[v2] > 0 or uw >= ebud[a, s]:
+                    cv, sl = _cover_incident(v0, v1, v2, pos, elem, inc, icnt, emult)
+                    cover = cv
+                    ncov[a, s] = cv
+                    if not new:
+                        ti.atomic_add(pflags[P_RECOUNT], 1)
+                    ebud[a, s] = sl - uw - SLACK_FLOOR * rad[a]
                 xa, xb, xc = pos[a], pos[b], pos[c]
                 va, vb, vc = vel[a], vel[b], vel[c]
                 h = 0.5 * dt
@@ -874,26 +1165,18 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                 ea = (xb - h * vb) - (xa - h * va)
                 eb = (xc - h * vc) - (xa - h * va)
                 area = 0.5 * (ea[0] * eb[1] - ea[1] * eb[0])
-                sig = (psig[a] + psig[b] + psig[c]) / 3.0
+                sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
                 eps = 0.0
                 flag = 0
                 if kind != JWL_TYPE:
                     # (a JWL element takes the mean of its particles' pressures: the
                     # particles carry the equation of state, see the gather below)
+                    found = False
                     if ti.static(carry):
-                        # an element that existed last step continues from its own stress
-                        found = False
-                        for t in ti.static(range(3)):
-                            o, u, w = a, b, c
-                            if ti.static(t == 1):
-                                o, u, w = b, c, a
-                            if ti.static(t == 2):
-                                o, u, w = c, a, b
-                            if not found:
-                                for so in range(ecnt_old[o]):
-                                    if elem_old[o, so, 0] == u and elem_old[o, so, 1] == w:
-                                        sig = esig_old[o, so]
-                                        found = True
+                        sig, found = _carried(a, b, c, s, elem, ecnt, esig, elem_old,
+                                              esig_old, ecnt_old, esrc, prb)
+                    if not found:
+                        sig = (psig[a] + psig[b] + psig[c]) / 3.0
                     sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
                         de, matp[M, 2], matp[M, 3])
                     failed = 0
@@ -902,131 +1185,168 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                     sig, eps, flag = mc_correct_state(sig, matp, M, failed)
                 esig[a, s] = sig
                 q = bulk_viscosity(matp, M, de, dt, area)
-                ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64),
-                                       area / cover, q * (de[0] + de[1])])
+                if ti.static(eos):
+                    ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64),
+                                           area / cover, q * (de[0] + de[1])])
+                fa = ti.Vector([0.0, 0.0])
+                fb = ti.Vector([0.0, 0.0])
+                fc = ti.Vector([0.0, 0.0])
                 if not _has_eos(matp, M):
                     sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
                     fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
-                    efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
-    if ti.static(jwl):
-        # 2j. particles with an equation of state (JWL, or a Fluid with
-        #     ``equation_of_state``; ``jwl`` is set whenever there are any): the state
-        #     at x_n. A particle's volume changes by a third of Σ_e (S_e/N_e) Δθ_e over
-        #     its elements (so that Σ_i p_i ΔVol_i is the elements' pressure work
-        #     exactly). JWL: its energy changes by −(p + q) ΔVol with the p its
-        #     elements pushed with over that change (last step's, so that the energy
-        #     lost is exactly the work the forces did), p = F·p_JWL(V, E) with F the
-        #     programmed burn fraction. Fluid: p(V) of :class:`physics.materials.Fluid`
-        #     (a state function: deleting or creating elements does not change it).
-        ti.loop_config(serialize=serial)
-        for i in range(n):
-            M = pmat[i]
-            if M >= 0:
-                if _has_eos(matp, M):
-                    thsum = 0.0
-                    qsum = 0.0
-                    for k in range(icnt[i]):
-                        code = inc[i, k]
-                        o = code >> 4
-                        sl = code & 15
-                        d = ede[o, sl]
-                        mw = ti.cast(emult[o, sl], ti.f64)
-                        thsum += mw * d[5] * (d[0] + d[1])
-                        qsum += mw * d[5] * d[6]
-                    js = pjwl[i]
-                    V0 = js[4]
-                    V = js[0] + thsum / (3.0 * V0)
-                    if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
-                        F = 0.0
-                        if time >= js[2]:
-                            F = ti.min(1.0, (time - js[2]) * matp[M, 10] / (3.0 * rad[i]))
-                        E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
-                        p = F * jwl_pressure(matp, M, V, E)
-                        pjwl[i] = ti.Vector([V, E, js[2], p, V0])
-                    else:
-                        pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), V0])
-        # 2k. their elements: the mean pressure of their particles, the viscous stress
-        #     2μ·dev(D) (Fluid) and the artificial bulk viscosity q (forces only)
-        ti.loop_config(serialize=serial)
-        for a in range(n):
-            for s in range(ecnt[a]):
-                if emult[a, s] > 0:
-                    M = pmat[a]
-                    if _has_eos(matp, M):
-                        b = elem[a, s, 0]
-                        c = elem[a, s, 1]
-                        pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
-                        sig = ti.Vector([-pm, -pm, 0.0, -pm])
-                        esig[a, s] = sig
-                        d = ede[a, s]
-                        de = ti.Vector([d[0], d[1], d[2]])
-                        q = 0.0
-                        if d[0] + d[1] < 0.0:
-                            q = d[6] / (d[0] + d[1])
-                        sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
-                        fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
-                        efor[a, s] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
-    # 2b. every copy takes its triangle's stress and N_e (from the computed copy)
+                efor[a, s] = _record(fa, fb, fc, sig, de, eps, ti.cast(flag, ti.f64),
+                                     ti.cast(emult[a, s], ti.f64))
+
+
+@ti.kernel
+def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
+                      rad: ti.types.ndarray(), pos: ti.types.ndarray(),
+                      elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+                      emult: ti.types.ndarray(), inc: ti.types.ndarray(),
+                      icnt: ti.types.ndarray(), ncov: ti.types.ndarray(),
+                      esig: ti.types.ndarray(), efor: ti.types.ndarray(),
+                      ede: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
+                      time: ti.f64, serial: ti.template()):
+    """2j. Particles with an equation of state (JWL, or a Fluid with
+    ``equation_of_state``): the state at x_n. A particle's volume changes by a third
+    of Σ_e (S_e/N_e) Δθ_e over its elements (so that Σ_i p_i ΔVol_i is the elements'
+    pressure work exactly). JWL: its energy changes by −(p + q) ΔVol with the p its
+    elements pushed with over that change (last step's, so that the energy lost is
+    exactly the work the forces did), p = F·p_JWL(V, E) with F the programmed burn
+    fraction. Fluid: p(V) of :class:`physics.materials.Fluid` (a state function:
+    deleting or creating elements does not change it).
+    2k. Their elements: the mean pressure of their particles, the viscous stress
+    2μ·dev(D) (Fluid) and the artificial bulk viscosity q (forces only)."""
+    n = pmat.shape[0]
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        M = pmat[i]
+        if M >= 0:
+            if _has_eos(matp, M):
+                thsum = 0.0
+                qsum = 0.0
+                for k in range(icnt[i]):
+                    code = inc[i, k]
+                    o = code >> 6
+                    sl = (code >> 2) & 15
+                    d = ede[o, sl]
+                    mw = ti.cast(emult[o, sl], ti.f64)
+                    thsum += mw * d[5] * (d[0] + d[1])
+                    qsum += mw * d[5] * d[6]
+                js = pjwl[i]
+                V0 = js[4]
+                V = js[0] + thsum / (3.0 * V0)
+                if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                    F = 0.0
+                    if time >= js[2]:
+                        F = ti.min(1.0, (time - js[2]) * matp[M, 10] / (3.0 * rad[i]))
+                    E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
+                    p = F * jwl_pressure(matp, M, V, E)
+                    pjwl[i] = ti.Vector([V, E, js[2], p, V0])
+                else:
+                    pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), V0])
     ti.loop_config(serialize=serial)
     for a in range(n):
         for s in range(ecnt[a]):
-            if emult[a, s] == 0:
-                b = elem[a, s, 0]
-                c = elem[a, s, 1]
-                for t in ti.static(range(2)):
-                    o, u, w = b, c, a
-                    if ti.static(t == 1):
-                        o, u, w = c, a, b
-                    if o < a:
-                        for so in range(ecnt[o]):
-                            if elem[o, so, 0] == u and elem[o, so, 1] == w and emult[o, so] > 0:
-                                esig[a, s] = esig[o, so]
-                                ncov[a, s] = ncov[o, so]
-    # 3. gather per particle
+            if emult[a, s] > 0:
+                M = pmat[a]
+                if _has_eos(matp, M):
+                    b = elem[a, s, 0]
+                    c = elem[a, s, 1]
+                    pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
+                    sig = ti.Vector([-pm, -pm, 0.0, -pm])
+                    esig[a, s] = sig
+                    d = ede[a, s]
+                    de = ti.Vector([d[0], d[1], d[2]])
+                    q = 0.0
+                    if d[0] + d[1] < 0.0:
+                        q = d[6] / (d[0] + d[1])
+                    sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
+                    fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
+                    efor[a, s] = _record(fa, fb, fc, sig, de, d[3], d[4], ti.cast(emult[a, s],
+                                                                                  ti.f64))
+
+
+@ti.kernel
+def copy_stress(pmat: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+                emult: ti.types.ndarray(), ecopy: ti.types.ndarray(),
+                esig: ti.types.ndarray(), ncov: ti.types.ndarray(), serial: ti.template()):
+    """2b. Every copy takes its triangle's stress and N_e from the computed copy."""
     ti.loop_config(serialize=serial)
-    for i in range(n):
-        for k in range(encnt[i]):
-            cskip[i, k] = 0
+    for a in range(pmat.shape[0]):
+        for s in range(ecnt[a]):
+            if emult[a, s] == 0:
+                code = ecopy[a, s]
+                o = code >> 4
+                so = code & 15
+                esig[a, s] = esig[o, so]
+                ncov[a, s] = ncov[o, so]
+
+
+@ti.kernel
+def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
+           matp: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
+           elem: ti.types.ndarray(), emult: ti.types.ndarray(), inc: ti.types.ndarray(),
+           icnt: ti.types.ndarray(), esig: ti.types.ndarray(), efor: ti.types.ndarray(),
+           ede: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
+           pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), pjwl: ti.types.ndarray(),
+           enbr: ti.types.ndarray(), encnt: ti.types.ndarray(), cskip: ti.types.ndarray(),
+           pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), first: ti.i32,
+           full: ti.i32, jwl: ti.template(), serial: ti.template()):
+    """3. Per particle (gathered, no atomics): force of its elements → xforce,
+    stress = mean of its elements' σ (zero in none), strain and plastic shear
+    strain += the means of the increments; the engine's pair slots (``cskip``,
+    rewritten where the elements around the particle changed, at the start of an
+    epoch and at the first two steps): 1 for two particles that are corners of a
+    common element (no DEM contact: the element carries their interaction; the
+    contact law records their overlap, from which it counts when it takes over, see
+    :func:`tdem.step.pair_contact`), and for same-body Fluid or JWL neighbours
+    (:func:`fluid_core_force`); 2, at the first step only, for the other same-body
+    Eq. 1 neighbours (the contact law starts from their initial overlap: a touching
+    pair left out of the elements by the angular pruning does not push apart). All
+    other touching pairs — sharing no element, whether in elements or not, same
+    body or not — meet through the contact law, so that particles cannot pass
+    through each other."""
+    new = pflags[P_NEW] != 0
+    ti.loop_config(serialize=serial)
+    for i in range(pmat.shape[0]):
+        redo = new or pdirty[i] != 0
+        if redo:
+            for k in range(encnt[i]):
+                cskip[i, k] = 0
         if pmat[i] >= 0:
             f = ti.Vector([0.0, 0.0])
             ssum = ti.Vector([0.0, 0.0, 0.0, 0.0])
             dsum = ti.Vector([0.0, 0.0, 0.0])
             psum = 0.0
             hit = 0
-            cnt = 0
+            cnt = 0.0
             for q in range(icnt[i]):
                 code = inc[i, q]
-                o = code >> 4
-                s = code & 15
-                e1 = elem[o, s, 0]
-                e2 = elem[o, s, 1]
-                c = _corner(o, e1, e2, i)
-                if c >= 0:
-                    mw = emult[o, s]
-                    fo = efor[o, s]
-                    f += mw * ti.Vector([fo[2 * c], fo[2 * c + 1]])
-                    ssum += mw * esig[o, s]
-                    d = ede[o, s]
-                    dsum += mw * ti.Vector([d[0], d[1], d[2]])
-                    psum += mw * d[3]
-                    if d[4] > 0.0:
-                        hit = 1
-                    cnt += mw
-            # pair slots of same-body Eq. 1 neighbours (both lists sorted): 1, no DEM
-            # contact, when they share an element or are fluid (Fluid, JWL); 2 at the
-            # first step for the others (docstring)
+                c = code & 3
+                r = efor[code >> 6, (code >> 2) & 15]
+                mw = r[15]
+                f += mw * ti.Vector([r[2 * c], r[2 * c + 1]])
+                ssum += mw * ti.Vector([r[6], r[7], r[8], r[9]])
+                dsum += mw * ti.Vector([r[10], r[11], r[12]])
+                psum += mw * r[13]
+                if r[14] > 0.0:
+                    hit = 1
+                cnt += mw
             kind_i = ti.cast(matp[pmat[i], 0], ti.i32)
             fluid = kind_i == FLUID or kind_i == JWL_TYPE
-            q = 0
-            for k in range(encnt[i]):
-                j = enbr[i, k]
-                while q < ncnt[i] and nbr[i, q] < j:
-                    q += 1
-                if q < ncnt[i] and nbr[i, q] == j:
-                    if fluid or _shares_element(i, j, inc, icnt, elem):
-                        cskip[i, k] = 1
-                    elif first != 0:
-                        cskip[i, k] = 2
+            if redo:
+                # pair slots of same-body Eq. 1 neighbours (both lists sorted)
+                q = 0
+                for k in range(encnt[i]):
+                    j = enbr[i, k]
+                    while q < ncnt[i] and nbr[i, q] < j:
+                        q += 1
+                    if q < ncnt[i] and nbr[i, q] == j:
+                        if fluid or _shares_element(i, j, inc, icnt, elem):
+                            cskip[i, k] = 1
+                        elif first != 0:
+                            cskip[i, k] = 2
             if fluid:
                 # Fluid and JWL products: same-body Eq. 1 neighbours never meet through
                 # the contact law (no friction between fluid particles, and no force
@@ -1038,7 +1358,7 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                     f += fluid_core_force(matp, pmat[i], xi, pos[j], rad[i] + rad[j])
             xforce[i] = f
             st = pstate[i]
-            if cnt > 0:
+            if cnt > 0.0:
                 inv = 1.0 / cnt
                 psig[i] = ssum * inv
                 peps[i] += dsum * inv
@@ -1052,10 +1372,48 @@ def update(pos: ti.types.ndarray(), vel: ti.types.ndarray(), rad: ti.types.ndarr
                     psig[i] = ti.Vector([-p, -p, 0.0, -p])
             if hit == 1:
                 st[1] = 1.0
-            st[2] = ti.cast(cnt, ti.f64)
+            st[2] = cnt
             pstate[i] = st
         else:
             xforce[i] = ti.Vector([0.0, 0.0])
+
+
+def update(a, e, dt, time, first, full, carry, eos, serial):
+    """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16) for the particles of x_n
+    moving at v_{n−1/2}, in the order the data flows. ``a``: the continuum's arrays
+    (:class:`tdem.continuum.Continuum`), ``e``: the engine's (positions, velocities,
+    pair lists and slots). ``first``: the first step of the run; ``full``: rebuild
+    everything (first step, after a restore); ``carry``: an element that existed
+    last step continues from its own stress; ``eos``: there are particles with an
+    equation of state.
+
+    pstate[i] = (plastic shear strain, failed (0/1), elements containing i, −).
+    """
+    full = int(bool(full) or bool(first))
+    displacements(e["pos"], a["pmat"], a["xref"], a["pu"], a["pflags"], full, serial)
+    rebuild_elements(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
+                     a["nbr"], a["ncnt"], a["ring"], a["rang"], a["elem"], a["ecnt"],
+                     a["earea"], a["esig"], a["elem_old"], a["esig_old"], a["ecnt_old"],
+                     a["esrc"], a["pu"], a["pbud"], a["prb"], a["pflags"], full, serial)
+    mark_dirty(a["pmat"], a["nbr"], a["ncnt"], a["pu"], a["prb"], a["pdirty"], a["unb"],
+               serial)
+    copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], serial)
+    incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
+              a["picnt"], a["pdirty"], a["pflags"], serial)
+    stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
+             a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["efor"], a["ede"],
+             a["psig"], a["pstate"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
+             a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], full, dt, carry,
+             eos, serial)
+    if eos:
+        equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
+                          a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],
+                          a["efor"], a["ede"], a["pjwl"], dt, time, serial)
+    copy_stress(a["pmat"], a["ecnt"], a["emult"], a["ecopy"], a["esig"], a["ncov"], serial)
+    gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
+           a["emult"], a["pinc"], a["picnt"], a["esig"], a["efor"], a["ede"], a["psig"],
+           a["peps"], a["pstate"], a["xforce"], a["pjwl"], e["nbr"], e["ncnt"], e["cskip"],
+           a["pdirty"], a["pflags"], int(first), full, eos, serial)
 
 
 @ti.func
@@ -1089,8 +1447,8 @@ def _shares_element(i, j, inc: ti.template(), icnt: ti.template(), elem: ti.temp
     found = False
     for q in range(icnt[i]):
         code = inc[i, q]
-        o = code >> 4
-        s = code & 15
+        o = code >> 6
+        s = (code >> 2) & 15
         if o == j or elem[o, s, 0] == j or elem[o, s, 1] == j:
             found = True
     return found

@@ -34,7 +34,8 @@ def init(arch=None, threads=None):
         if name == _state["arch"] and (threads is None or threads == _state["threads"]):
             return name
     kwargs = dict(arch=_arch_from(name), default_fp=ti.f64, default_ip=ti.i32,
-                  offline_cache=True, log_level=ti.WARN)
+                  offline_cache=True, log_level=ti.WARN,
+                  kernel_profiler=bool(os.environ.get("TDEM_PROFILE")))
     if threads is not None:
         if threads < 1:
             raise InputError(f"threads must be >= 1, got {threads!r}")

@@ -5,6 +5,8 @@ One step of a model with continua (:meth:`tdem.Simulation._one_step`):
     neighbour lists (engine, when the skin asks)
       -> PCMM candidates (only after a list build)            physics.pcmm.candidates
       -> PCMM elements, stresses, nodal forces, gathered     physics.pcmm.update
+         (displacements -> rebuild_elements -> mark_dirty -> copies -> incidence
+          -> stresses -> equation_of_state -> copy_stress -> gather)
       -> block element stresses and nodal forces            physics.blocks.update
       -> DEM contacts + element forces, leapfrog           tdem.step.step
       -> block nodes: damping, prescribed velocities, leapfrog   integrate_nodes
@@ -202,7 +204,7 @@ class Continuum:
         a["earea"] = ti.ndarray(ti.f64, (n, E))
         a["ncov"] = ti.ndarray(ti.i32, (n, E))
         a["esig"] = _arr(4, (n, E))
-        a["efor"] = _arr(6, (n, E))
+        a["efor"] = _arr(16, (n, E))
         a["ede"] = _arr(7, (n, E))
         a["psig"] = _arr(4, (n,))
         a["peps"] = _arr(3, (n,))
@@ -218,8 +220,19 @@ class Continuum:
         a["elem_old"] = ti.ndarray(ti.i32, (n, E, 2))
         a["esig_old"] = _arr(4, (n, E))
         a["ecnt_old"] = ti.ndarray(ti.i32, (n,))
+        # lazy rebuild bookkeeping (physics.pcmm.rebuild_elements)
+        a["xref"] = _arr(2, (n,))
+        a["pu"] = _arr(2, (n,))
+        a["unb"] = ti.ndarray(ti.f64, (n,))
+        a["pbud"] = ti.ndarray(ti.f64, (n,))
+        a["prb"] = ti.ndarray(ti.i32, (n,))
+        a["pdirty"] = ti.ndarray(ti.i32, (n,))
+        a["esrc"] = ti.ndarray(ti.i32, (n, E))
+        a["ecopy"] = ti.ndarray(ti.i32, (n, E))
+        a["ebud"] = ti.ndarray(ti.f64, (n, E))
+        self._full = True
         a["pflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
-        a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
+        a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
         self._alloc_lists()
         self._setup_blocks()
         self._setup_couples(couples)
@@ -289,7 +302,7 @@ class Continuum:
         a["rang"] = ti.ndarray(ti.f64, (n, cap))
         if old is not None:
             # forces a candidate build at the next step
-            a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
+            a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
 
     def _setup_blocks(self):
         a = self.a
@@ -526,14 +539,11 @@ class Continuum:
                             e["cell_count"], e["cell_start"], e["sorted"], e["gridp"],
                             e["gridn"], e["flags"], a["pflags"], F_BUILDS,
                             float(sim.skin), int(reach))
-            pcmm.update(e["pos"], e["vel"], a["rad"], a["pmat"], a["matp"], a["mtol"],
-                        a["cand"], a["ccnt"], a["nbr"], a["ncnt"], a["ring"], a["rang"],
-                        a["elem"], a["ecnt"], a["earea"], a["ncov"], a["esig"], a["efor"],
-                        a["ede"], a["psig"], a["peps"], a["pstate"], a["xforce"], e["nbr"],
-                        e["ncnt"], e["cskip"], a["pinc"], a["picnt"], a["emult"], a["pflags"],
-                        a["elem_old"], a["esig_old"], a["ecnt_old"], a["pjwl"], float(dt),
-                        float(sim._time), int(sim.steps == 0), self.carry_stress,
-                        self.eos, serial)
+            # everything is rebuilt at the first two steps (cskip's first-step marks
+            # go at the second) and after a restore
+            pcmm.update(a, e, float(dt), float(sim._time), int(sim.steps == 0),
+                        self._full or sim.steps <= 1, self.carry_stress, self.eos, serial)
+            self._full = False
         if self.nv:
             blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
                        a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
@@ -650,7 +660,8 @@ class Continuum:
             if src is not None and tuple(src.shape) == tuple(dst.shape):
                 dst.copy_from(src)
         if self.snap.get("cand") is None:
-            self.a["pflags"].from_numpy(np.array([0, -1, 0, 0], np.int32))
+            self.a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
+        self._full = True
 
     # ------------------------------------------------------------------ reading
     def elements(self):
