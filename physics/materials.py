@@ -701,7 +701,18 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
                 act[0] = k
             else:
                 act[0] = 6 + i3
-            ok, g, q = _try(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2, tol)
+            # FLAC's one-plane return (what _try gives for one plane, directly)
+            nk, ck, mk = _plane(act[0], nphi, npsi, sq, coh, ten)
+            dk = _dmul(mk, a1, a2)
+            A = nk.dot(dk)
+            ok = 0
+            g = ti.Vector([0.0, 0.0, 0.0])
+            q = p
+            if A != 0.0:
+                g[0] = (nk.dot(p) + ck) / A
+                q = p - g[0] * dk
+                if g[0] >= 0.0 and _admissible(q, nphi, sq, coh, ten, tol):
+                    ok = 1
             # FLAC's return not admissible: the first admissible active set, by size
             if ok == 0:
                 act0 = act

@@ -67,9 +67,11 @@ translation, so what is tracked is each particle's displacement u since the
 epoch began *relative to the particle whose rules they are*: with u measured from
 the epoch's start, a particle built when the largest relative u around it was W
 keeps its elements while the largest relative u around it stays below
-slack − W. An epoch begins at the first steps, after a restore, when the engine
-rebuilds its neighbour lists (the candidates change) and after a step that had to
-rebuild many particles or recount many N_e (the slack left shrinks as the u grow).
+slack − W. When the engine rebuilds its neighbour lists, a particle's new
+candidates (beyond the Eq. 1 cut-off until then, by the engine's skin) add their
+own slack. An epoch begins at the first steps, after a restore and after a step
+that had to rebuild many particles or recount many N_e (the slack left shrinks as
+the u grow).
 
 Arrays
 ------
@@ -753,6 +755,7 @@ P_EPOCH = 3      # the P_BUILDS value the current epoch began at (rebuild_elemen
 P_NEW = 4        # 1: this step begins an epoch
 P_REBUILT = 5    # particles that rebuilt their elements this step
 P_RECOUNT = 6    # elements whose N_e was recounted this step
+P_BUILT = 7      # 1: the candidates were rebuilt this step (the engine rebuilt its lists)
 PFLAGS_SIZE = 8
 PFLAGS_INIT = (0, -1, 0, 0, 1, 0, 0, 0)
 EPOCH_REBUILT = 0.05   # a new epoch begins after a step that rebuilt this fraction
@@ -883,18 +886,19 @@ def displacements(pos: ti.types.ndarray(), pmat: ti.types.ndarray(),
                   pflags: ti.types.ndarray(), full: ti.i32, serial: ti.template()):
     """0. u_i = |x_i − x_ref,i|, the distance each particle has moved since the
     epoch began. An epoch begins (x_ref = x, everything rebuilt) at the first step,
-    after a restore, whenever the candidates were rebuilt (the engine rebuilt its
-    lists) and after a step in which many particles rebuilt or many elements were
-    recounted (the slack left shrinks as the u grow: ``EPOCH_REBUILT``,
-    ``EPOCH_RECOUNT``)."""
+    after a restore and after a step in which many particles rebuilt or many
+    elements were recounted (the slack left shrinks as the u grow:
+    ``EPOCH_REBUILT``, ``EPOCH_RECOUNT``). ``P_BUILT``: the candidates were rebuilt
+    this step."""
     n = pos.shape[0]
     ti.loop_config(serialize=True)
     for _ in range(1):
         new = 0
-        if full != 0 or pflags[P_EPOCH] != pflags[P_BUILDS] or \
-                pflags[P_REBUILT] > EPOCH_REBUILT * n or pflags[P_RECOUNT] > EPOCH_RECOUNT * n:
+        if full != 0 or pflags[P_REBUILT] > EPOCH_REBUILT * n or \
+                pflags[P_RECOUNT] > EPOCH_RECOUNT * n:
             new = 1
         pflags[P_NEW] = new
+        pflags[P_BUILT] = 1 if pflags[P_EPOCH] != pflags[P_BUILDS] else 0
         pflags[P_EPOCH] = pflags[P_BUILDS]
         pflags[P_REBUILT] = 0
         pflags[P_RECOUNT] = 0
@@ -935,6 +939,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
     the old slot of the same element (``esrc``, −1 for a new one).
     """
     new = pflags[P_NEW] != 0
+    built = pflags[P_BUILT] != 0
     ti.loop_config(serialize=serial)
     for i in range(pos.shape[0]):
         m = pmat[i]
@@ -944,6 +949,24 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
             ui = pu[i]
             for q in range(ccnt[i]):
                 umax = ti.max(umax, (pu[cand[i, q]] - ui).norm())
+            if built and not new:
+                # new candidates: the particles not listed before stayed beyond the
+                # Eq. 1 cut-off until now (the engine's skin); from now on each keeps
+                # its own slack (both lists sorted)
+                xi = pos[i]
+                k = 0
+                for q in range(ccnt[i]):
+                    j = cand[i, q]
+                    while k < ncnt[i] and nbr[i, k] < j:
+                        k += 1
+                    if not (k < ncnt[i] and nbr[i, k] == j):
+                        d = (pos[j] - xi).norm()
+                        cut = rad[i] + rad[j] + mtol[m]
+                        if d <= cut:      # (the skin was just exceeded: it came in)
+                            pbud[i] = -1.0
+                        else:
+                            pbud[i] = ti.min(pbud[i], _dist_slack(d, cut) - (pu[j] - ui).norm()
+                                             - SLACK_FLOOR * rad[i])
             if new or umax >= pbud[i]:
                 prb[i] = 1
                 if not new:
@@ -1308,9 +1331,10 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
     body or not — meet through the contact law, so that particles cannot pass
     through each other."""
     new = pflags[P_NEW] != 0
+    built = pflags[P_BUILT] != 0
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
-        redo = new or pdirty[i] != 0
+        redo = new or built or pdirty[i] != 0
         if redo:
             for k in range(encnt[i]):
                 cskip[i, k] = 0

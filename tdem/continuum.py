@@ -301,8 +301,9 @@ class Continuum:
         a["ring"] = ti.ndarray(ti.i32, (n, cap))
         a["rang"] = ti.ndarray(ti.f64, (n, cap))
         if old is not None:
-            # forces a candidate build at the next step
+            # forces a candidate build and a full element rebuild at the next step
             a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
+            self._full = True
 
     def _setup_blocks(self):
         a = self.a
