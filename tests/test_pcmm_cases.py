@@ -1,8 +1,8 @@
 """The PCMM precision cases (Feng, Li & Oñate 2015 §3) against their targets.
 
 The default run checks the FVM block model and the regular and hexagonal ("cross")
-PCMM lattices (elastic_gravity: all four models); the random packings (slower to
-build and to run) of the other cases are in the slow tests. Targets and tolerances
+PCMM lattices, and the random packing of wave_bar and elastic_gravity; the random
+packing of uniaxial_compression (slower to build and to run) is in the slow tests. Targets and tolerances
 are those of the case docstrings (CASES.md).
 """
 import math
@@ -16,11 +16,10 @@ from cases import elastic_gravity, uniaxial_compression, wave_bar
 
 @pytest.fixture(scope="module")
 def wave(tmp_path_factory):
-    return wave_bar.run("quick", out=tmp_path_factory.mktemp("wave"),
-                        models=["fvm", "regular", "cross"])
+    return wave_bar.run("quick", out=tmp_path_factory.mktemp("wave"))
 
 
-@pytest.mark.parametrize("model", ["fvm", "regular", "cross"])
+@pytest.mark.parametrize("model", ["fvm", "regular", "cross", "random"])
 def test_wave_bar_arrival_peak_velocity_and_stress(wave, model):
     m = wave["models"][model]
     # arrival at x = 10 m within 5 % of 10 m / c (c = sqrt(E/(rho (1 - nu^2))))
@@ -54,16 +53,6 @@ def test_uniaxial_all_five_models(tmp_path):
     s = uniaxial_compression.run("quick", out=tmp_path)
     assert s["elastic_slope_pass"]
     assert all(m["peak_stress_pass"] for m in s["models"].values())
-
-
-@pytest.mark.slow
-@pytest.mark.xfail(reason="the random PCMM packing carries the wave about 20 % slow and at "
-                          "less than half the stress (a known gap)", strict=False)
-def test_wave_bar_random_model(tmp_path):
-    s = wave_bar.run("quick", out=tmp_path, models=["random"])
-    m = s["models"]["random"]
-    assert m["peak_velocity_pass"]
-    assert m["arrival_pass"] and m["peak_stress_pass"]
 
 
 @pytest.fixture(scope="module")
