@@ -490,6 +490,9 @@ class Continuum:
             tol[s] = 0.0 if t is None else t
         self.a["matp"].from_numpy(rows)
         self.a["mtol"].from_numpy(tol)
+        if not np.array_equal(tol, getattr(self, "_tol", tol)):
+            self._full = True        # the Eq. 1 cut-offs changed: rebuild every element
+        self._tol = tol
 
     def apply_node_fixes(self, t, initial=False):
         """Upload prescribed node velocities (all, or the functions of time at t)."""
