@@ -923,7 +923,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                      elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
                      ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(),
                      pu: ti.types.ndarray(), pbud: ti.types.ndarray(),
-                     prb: ti.types.ndarray(), pflags: ti.types.ndarray(), full: ti.i32,
+                     prb: ti.types.ndarray(), pflags: ti.types.ndarray(),
                      serial: ti.template()):
     """1. The element set the rules give now, rebuilt only where it can have changed.
 
@@ -1147,7 +1147,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
              elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
              ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(), prb: ti.types.ndarray(),
              pdirty: ti.types.ndarray(), unb: ti.types.ndarray(), pu: ti.types.ndarray(),
-             pflags: ti.types.ndarray(), full: ti.i32, dt: ti.f64, carry: ti.template(),
+             pflags: ti.types.ndarray(), dt: ti.f64, carry: ti.template(),
              eos: ti.template(), serial: ti.template()):
     """2. Per computed element: N_e (probe rule; recounted where the elements around
     it changed or its vertices' neighbourhoods moved farther than the count's slack,
@@ -1315,7 +1315,7 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
            pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), pjwl: ti.types.ndarray(),
            enbr: ti.types.ndarray(), encnt: ti.types.ndarray(), cskip: ti.types.ndarray(),
            pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), first: ti.i32,
-           full: ti.i32, jwl: ti.template(), serial: ti.template()):
+           jwl: ti.template(), serial: ti.template()):
     """3. Per particle (gathered, no atomics): force of its elements → xforce,
     stress = mean of its elements' σ (zero in none), strain and plastic shear
     strain += the means of the increments; the engine's pair slots (``cskip``,
@@ -1418,7 +1418,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     rebuild_elements(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
                      a["nbr"], a["ncnt"], a["ring"], a["rang"], a["elem"], a["ecnt"],
                      a["earea"], a["esig"], a["elem_old"], a["esig_old"], a["ecnt_old"],
-                     a["esrc"], a["pu"], a["pbud"], a["prb"], a["pflags"], full, serial)
+                     a["esrc"], a["pu"], a["pbud"], a["prb"], a["pflags"], serial)
     mark_dirty(a["pmat"], a["nbr"], a["ncnt"], a["pu"], a["prb"], a["pdirty"], a["unb"],
                serial)
     copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], serial)
@@ -1427,7 +1427,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
              a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["efor"], a["ede"],
              a["psig"], a["pstate"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
-             a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], full, dt, carry,
+             a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], dt, carry,
              eos, serial)
     if eos:
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
@@ -1437,7 +1437,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
            a["emult"], a["pinc"], a["picnt"], a["esig"], a["efor"], a["ede"], a["psig"],
            a["peps"], a["pstate"], a["xforce"], a["pjwl"], e["nbr"], e["ncnt"], e["cskip"],
-           a["pdirty"], a["pflags"], int(first), full, eos, serial)
+           a["pdirty"], a["pflags"], int(first), eos, serial)
 
 
 @ti.func
