@@ -131,9 +131,14 @@ def jaumann_rotate(sig, w, dt):
     With d = (σxx − σyy)/2 and τ = σxy, (d, τ) turns by 2φ; the mean (σxx + σyy)/2
     and σzz are unchanged.
     """
-    phi = 2.0 * ti.atan2(0.5 * w * dt, 1.0)
-    c = ti.cos(2.0 * phi)
-    s = ti.sin(2.0 * phi)
+    # cos 2φ and sin 2φ from t = tan(φ/2) without trigonometric calls:
+    # cos φ = (1 − t²)/(1 + t²), sin φ = 2t/(1 + t²)
+    t = 0.5 * w * dt
+    inv = 1.0 / (1.0 + t * t)
+    c1 = (1.0 - t * t) * inv
+    s1 = 2.0 * t * inv
+    c = c1 * c1 - s1 * s1
+    s = 2.0 * s1 * c1
     mean = 0.5 * (sig[0] + sig[1])
     d = 0.5 * (sig[0] - sig[1])
     tau = sig[2]

@@ -116,6 +116,7 @@ from .validate import in_range, non_negative, positive
 MAT_WIDTH = 14
 ELASTIC, MOHR_COULOMB, FLUID, JWL_TYPE = 0, 1, 2, 3
 NO_FAILURE, SHEAR_FAILURE, TENSION_FAILURE = 0, 1, 2
+MC_RETRY = -1          # mc_correct_fast: redo with mc_correct_state
 
 
 def _n_angle(deg):
@@ -635,7 +636,7 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
 
 
 @ti.func
-def mc_correct_state(s, matp: ti.template(), M, failed):
+def _mc_return(s, matp: ti.template(), M, failed, fallback: ti.template()):
     """Mohr–Coulomb + tension cut-off correction of a trial stress (module docstring).
 
     s: trial stress (σxx, σyy, σxy, σzz), tension-positive; M: row of ``matp``;
@@ -646,6 +647,9 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
     cut-off), 2 tension only). Elastic and Fluid rows return s unchanged. A kernel
     doing brittle softening marks the particle failed once flag > 0.
     A stress inside the surface is returned unchanged (bitwise).
+    ``fallback`` False: where FLAC's one-plane return is not admissible, return s
+    unchanged with flag MC_RETRY instead of searching the active sets (see
+    :func:`mc_correct_fast`).
     """
     out = s
     eps = 0.0
@@ -714,17 +718,18 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
                 if g[0] >= 0.0 and _admissible(q, nphi, sq, coh, ten, tol):
                     ok = 1
             # FLAC's return not admissible: the first admissible active set, by size
-            if ok == 0:
-                act0 = act
-                g0 = g
-                q0 = q
-                ok, act, nact, g, q = _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2,
-                                                        tol)
-                if ok == 0:          # none found (not expected): keep FLAC's return
-                    act = act0
-                    nact = 1
-                    g = g0
-                    q = q0
+            if ti.static(fallback):
+                if ok == 0:
+                    act0 = act
+                    g0 = g
+                    q0 = q
+                    ok, act, nact, g, q = _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2,
+                                                            tol)
+                    if ok == 0:          # none found (not expected): keep FLAC's return
+                        act = act0
+                        nact = 1
+                        g = g0
+                        q = q0
             # plastic strains of the shear planes, failure type
             eps_s = ti.Vector([0.0, 0.0, 0.0])
             shear_part = 0
@@ -744,7 +749,39 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
             cn = 0.5 * (q[0] + q[1])
             rn = 0.5 * (q[1] - q[0])
             out = ti.Vector([cn + rn * c2, cn - rn * c2, rn * s2, q[2]])
+            if ti.static(not fallback):
+                if ok == 0:
+                    out = s
+                    eps = 0.0
+                    flag = MC_RETRY
     return out, eps, flag
+
+
+@ti.func
+def mc_correct_state(s, matp: ti.template(), M, failed):
+    """Mohr–Coulomb + tension cut-off correction of a trial stress (module docstring).
+
+    s: trial stress (σxx, σyy, σxy, σzz), tension-positive; M: row of ``matp``;
+    failed: nonzero when the particle has failed before (brittle softening then uses
+    the residual c_r, T_r of columns 9–10).
+    Returns (corrected stress, plastic shear strain increment Δe^ps ≥ 0, flag:
+    0 no failure, 1 shear (a shear plane is active, alone or at a corner with the
+    cut-off), 2 tension only). Elastic and Fluid rows return s unchanged. A kernel
+    doing brittle softening marks the particle failed once flag > 0.
+    A stress inside the surface is returned unchanged (bitwise).
+    """
+    return _mc_return(s, matp, M, failed, True)
+
+
+@ti.func
+def mc_correct_fast(s, matp: ti.template(), M, failed):
+    """:func:`mc_correct_state` without the search of the active sets: where FLAC's
+    one-plane return is not admissible (rare: near a corner of the surface) it
+    returns (s, 0, MC_RETRY), and the caller redoes that stress with
+    :func:`mc_correct_state` in a second pass. Where it returns another flag the
+    result is that of :func:`mc_correct_state` bitwise. Keeping the search out of
+    the element kernel keeps that kernel small (the search is most of its code)."""
+    return _mc_return(s, matp, M, failed, False)
 
 
 @ti.func

@@ -230,6 +230,7 @@ class Continuum:
         a["esrc"] = ti.ndarray(ti.i32, (n, E))
         a["ecopy"] = ti.ndarray(ti.i32, (n, E))
         a["ebud"] = ti.ndarray(ti.f64, (n, E))
+        a["eretry"] = ti.ndarray(ti.i32, (n * E + 1,))   # physics.pcmm.stresses_retry
         self._full = True
         a["pflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
         a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
