@@ -1248,7 +1248,7 @@ def stresses_retry(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                    efor: ti.types.ndarray(), ede: ti.types.ndarray(),
                    pstate: ti.types.ndarray(), eretry: ti.types.ndarray(), dt: ti.f64,
                    eos: ti.template(), serial: ti.template()):
-    """2c. The elements :func:`stresses` listed: their trial stress (in ``esig``)
+    """2b. The elements :func:`stresses` listed: their trial stress (in ``esig``)
     corrected with the full search of :func:`physics.materials.mc_correct_state`,
     then the same end of step 2 (strain increment and area recomputed exactly as
     :func:`stresses` computes them)."""
@@ -1347,22 +1347,6 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
 
 
 @ti.kernel
-def copy_stress(pmat: ti.types.ndarray(), ecnt: ti.types.ndarray(),
-                emult: ti.types.ndarray(), ecopy: ti.types.ndarray(),
-                esig: ti.types.ndarray(), ncov: ti.types.ndarray(), serial: ti.template()):
-    """2b. Every copy takes its triangle's stress and N_e from the computed copy."""
-    ti.loop_config(serialize=serial)
-    for a in range(pmat.shape[0]):
-        for s in range(ecnt[a]):
-            if emult[a, s] == 0:
-                code = ecopy[a, s]
-                o = code >> 4
-                so = code & 15
-                esig[a, s] = esig[o, so]
-                ncov[a, s] = ncov[o, so]
-
-
-@ti.kernel
 def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
            matp: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
            elem: ti.types.ndarray(), emult: ti.types.ndarray(), inc: ti.types.ndarray(),
@@ -1370,9 +1354,12 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
            ede: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
            pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), pjwl: ti.types.ndarray(),
            enbr: ti.types.ndarray(), encnt: ti.types.ndarray(), cskip: ti.types.ndarray(),
-           pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), first: ti.i32,
+           pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+           ecopy: ti.types.ndarray(), ncov: ti.types.ndarray(), first: ti.i32,
            jwl: ti.template(), serial: ti.template()):
-    """3. Per particle (gathered, no atomics): force of its elements → xforce,
+    """3. Per particle (gathered, no atomics): its copies take their triangle's
+    stress and N_e from the computed copy (for next step's σ_old and the output);
+    force of its elements → xforce,
     stress = mean of its elements' σ (zero in none), strain and plastic shear
     strain += the means of the increments; the engine's pair slots (``cskip``,
     rewritten where the elements around the particle changed, at the start of an
@@ -1390,6 +1377,13 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
     built = pflags[P_BUILT] != 0
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
+        for s in range(ecnt[i]):
+            if emult[i, s] == 0:
+                code = ecopy[i, s]
+                o = code >> 4
+                so = code & 15
+                esig[i, s] = esig[o, so]
+                ncov[i, s] = ncov[o, so]
         redo = new or built or pdirty[i] != 0
         if redo:
             for k in range(encnt[i]):
@@ -1491,11 +1485,10 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],
                           a["efor"], a["ede"], a["pjwl"], dt, time, serial)
-    copy_stress(a["pmat"], a["ecnt"], a["emult"], a["ecopy"], a["esig"], a["ncov"], serial)
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
            a["emult"], a["pinc"], a["picnt"], a["esig"], a["efor"], a["ede"], a["psig"],
            a["peps"], a["pstate"], a["xforce"], a["pjwl"], e["nbr"], e["ncnt"], e["cskip"],
-           a["pdirty"], a["pflags"], int(first), eos, serial)
+           a["pdirty"], a["pflags"], a["ecnt"], a["ecopy"], a["ncov"], int(first), eos, serial)
 
 
 @ti.func

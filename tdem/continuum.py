@@ -6,7 +6,7 @@ One step of a model with continua (:meth:`tdem.Simulation._one_step`):
       -> PCMM candidates (only after a list build)            physics.pcmm.candidates
       -> PCMM elements, stresses, nodal forces, gathered     physics.pcmm.update
          (displacements -> rebuild_elements -> mark_dirty -> copies -> incidence
-          -> stresses -> equation_of_state -> copy_stress -> gather)
+          -> stresses -> stresses_retry -> equation_of_state -> gather)
       -> block element stresses and nodal forces            physics.blocks.update
       -> DEM contacts + element forces, leapfrog           tdem.step.step
       -> block nodes: damping, prescribed velocities, leapfrog   integrate_nodes
