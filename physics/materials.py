@@ -492,66 +492,6 @@ def _dmul(v, a1, a2):
 
 
 @ti.func
-def _solve_active(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2):
-    """Multipliers Δγ (vector, unused slots 0) and corrected principals for the
-    active planes act[0:nact]: Σ_c (n_b·D m_c) Δγ_c = F_b(p) for every active b.
-    Returns (ok, Δγ, principals); ok = 0 when the planes are dependent."""
-    n0, k0, m0 = _plane(act[0], nphi, npsi, sq, coh, ten)
-    n1, k1, m1 = _plane(act[1], nphi, npsi, sq, coh, ten)
-    n2, k2, m2 = _plane(act[2], nphi, npsi, sq, coh, ten)
-    d0 = _dmul(m0, a1, a2)
-    d1 = _dmul(m1, a1, a2)
-    d2 = _dmul(m2, a1, a2)
-    A = ti.Matrix.identity(ti.f64, 3)
-    r = ti.Vector([n0.dot(p) + k0, 0.0, 0.0])
-    A[0, 0] = n0.dot(d0)
-    if nact >= 2:
-        r[1] = n1.dot(p) + k1
-        A[0, 1] = n0.dot(d1)
-        A[1, 0] = n1.dot(d0)
-        A[1, 1] = n1.dot(d1)
-    if nact == 3:
-        r[2] = n2.dot(p) + k2
-        A[0, 2] = n0.dot(d2)
-        A[1, 2] = n1.dot(d2)
-        A[2, 0] = n2.dot(d0)
-        A[2, 1] = n2.dot(d1)
-        A[2, 2] = n2.dot(d2)
-    g = ti.Vector([0.0, 0.0, 0.0])
-    # a set of dependent planes (singular matrix, relative to its row sizes) fails
-    size = 1.0
-    for b in ti.static(range(3)):
-        size *= ti.abs(A[b, 0]) + ti.abs(A[b, 1]) + ti.abs(A[b, 2])
-    det = A.determinant()
-    ok = 0
-    if ti.abs(det) > 1e-10 * size:
-        ok = 1
-        if nact == 1:
-            g[0] = r[0] / A[0, 0]
-        else:
-            g = A.inverse() @ r
-    q = p - g[0] * d0
-    if nact >= 2:
-        q -= g[1] * d1
-    if nact == 3:
-        q -= g[2] * d2
-    return ok, g, q
-
-
-@ti.func
-def _try(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2, tol):
-    """Return with the active planes act[0:nact]; ok = 1 when every multiplier is
-    ≥ 0 and the result violates no plane of the criterion by more than tol."""
-    ok, g, q = _solve_active(p, act, nact, nphi, npsi, sq, coh, ten, a1, a2)
-    for c in ti.static(range(3)):
-        if c < nact and g[c] < 0.0:
-            ok = 0
-    if ok == 1 and not _admissible(q, nphi, sq, coh, ten, tol):
-        ok = 0
-    return ok, g, q
-
-
-@ti.func
 def _admissible(q, nphi, sq, coh, ten, tol):
     """Whether principal values q violate none of the nine planes by more than tol:
     the tension planes bind at the largest value, the shear planes at the pair
@@ -566,8 +506,9 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
     """The first admissible active set (all Δγ ≥ 0, no plane violated by more than
     tol) in the order: one plane (0–8), two planes, three planes, each
     lexicographically; the planes' gradients n_k, D m_k and values F_k(p) are
-    tabulated once. Returns (ok, act, nact, Δγ, principals) as :func:`_try` gives
-    them for that set."""
+    tabulated once. For a set S: Σ_{c∈S} (n_b·D m_c) Δγ_c = F_b(p) for every b in S
+    (dependent planes, |det| ≤ 1e-10 × the product of the rows' sizes, fail); the
+    principals are then p − Σ Δγ_c D m_c. Returns (ok, act, nact, Δγ, principals)."""
     N = ti.Matrix.zero(ti.f64, 9, 3)
     Dm = ti.Matrix.zero(ti.f64, 9, 3)
     F = ti.Vector.zero(ti.f64, 9)
@@ -624,14 +565,29 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
         for b in range(a + 1, 9):
             for c in range(b + 1, 9):
                 if ok == 0:
-                    st = ti.Vector([a, b, c])
-                    ok3, g3, q3 = _try(p, st, 3, nphi, npsi, sq, coh, ten, a1, a2, tol)
-                    if ok3 == 1:
-                        ok = 1
-                        act = st
-                        nact = 3
-                        g = g3
-                        q = q3
+                    na = ti.Vector([N[a, 0], N[a, 1], N[a, 2]])
+                    nb = ti.Vector([N[b, 0], N[b, 1], N[b, 2]])
+                    nc = ti.Vector([N[c, 0], N[c, 1], N[c, 2]])
+                    da = ti.Vector([Dm[a, 0], Dm[a, 1], Dm[a, 2]])
+                    db = ti.Vector([Dm[b, 0], Dm[b, 1], Dm[b, 2]])
+                    dc = ti.Vector([Dm[c, 0], Dm[c, 1], Dm[c, 2]])
+                    A = ti.Matrix([[na.dot(da), na.dot(db), na.dot(dc)],
+                                   [nb.dot(da), nb.dot(db), nb.dot(dc)],
+                                   [nc.dot(da), nc.dot(db), nc.dot(dc)]])
+                    size = 1.0
+                    for r in ti.static(range(3)):
+                        size *= ti.abs(A[r, 0]) + ti.abs(A[r, 1]) + ti.abs(A[r, 2])
+                    det = A.determinant()
+                    if ti.abs(det) > 1e-10 * size:
+                        g3 = A.inverse() @ ti.Vector([F[a], F[b], F[c]])
+                        if g3[0] >= 0.0 and g3[1] >= 0.0 and g3[2] >= 0.0:
+                            q3 = p - g3[0] * da - g3[1] * db - g3[2] * dc
+                            if _admissible(q3, nphi, sq, coh, ten, tol):
+                                ok = 1
+                                act = ti.Vector([a, b, c])
+                                nact = 3
+                                g = g3
+                                q = q3
     return ok, act, nact, g, q
 
 
@@ -705,7 +661,7 @@ def _mc_return(s, matp: ti.template(), M, failed, fallback: ti.template()):
                 act[0] = k
             else:
                 act[0] = 6 + i3
-            # FLAC's one-plane return (what _try gives for one plane, directly)
+            # FLAC's one-plane return
             nk, ck, mk = _plane(act[0], nphi, npsi, sq, coh, ten)
             dk = _dmul(mk, a1, a2)
             A = nk.dot(dk)
