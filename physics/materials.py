@@ -593,20 +593,9 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
 
 @ti.func
 def _mc_return(s, matp: ti.template(), M, failed, fallback: ti.template()):
-    """Mohr–Coulomb + tension cut-off correction of a trial stress (module docstring).
-
-    s: trial stress (σxx, σyy, σxy, σzz), tension-positive; M: row of ``matp``;
-    failed: nonzero when the particle has failed before (brittle softening then uses
-    the residual c_r, T_r of columns 9–10).
-    Returns (corrected stress, plastic shear strain increment Δe^ps ≥ 0, flag:
-    0 no failure, 1 shear (a shear plane is active, alone or at a corner with the
-    cut-off), 2 tension only). Elastic and Fluid rows return s unchanged. A kernel
-    doing brittle softening marks the particle failed once flag > 0.
-    A stress inside the surface is returned unchanged (bitwise).
-    ``fallback`` False: where FLAC's one-plane return is not admissible, return s
-    unchanged with flag MC_RETRY instead of searching the active sets (see
-    :func:`mc_correct_fast`).
-    """
+    """:func:`mc_correct_state` (``fallback`` True) or :func:`mc_correct_fast`
+    (False: where FLAC's one-plane return is not admissible, s unchanged with flag
+    MC_RETRY instead of the search of the active sets)."""
     out = s
     eps = 0.0
     flag = NO_FAILURE

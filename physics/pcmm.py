@@ -1180,17 +1180,9 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                         ti.atomic_add(pflags[P_RECOUNT], 1)
                     ebud[a, s] = sl - uw - SLACK_FLOOR * rad[a]
                 xa, xb, xc = pos[a], pos[b], pos[c]
-                va, vb, vc = vel[a], vel[b], vel[c]
-                h = 0.5 * dt
-                grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
-                de = fvm.strain_increment(grad, dt)
+                grad, de, area = _kinematics(a, b, c, pos, vel, dt)
                 M = pmat[a]
                 kind = ti.cast(matp[M, 0], ti.i32)
-                # area on the mid-step configuration: Δθ·area is then exactly the
-                # area change of the step (the area is quadratic in the positions)
-                ea = (xb - h * vb) - (xa - h * va)
-                eb = (xc - h * vc) - (xa - h * va)
-                area = 0.5 * (ea[0] * eb[1] - ea[1] * eb[0])
                 sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
                 eps = 0.0
                 flag = 0
@@ -1217,6 +1209,18 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                 else:
                     _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp, emult,
                             efor, ede, dt, eos)
+
+
+@ti.func
+def _kinematics(a, b, c, pos: ti.template(), vel: ti.template(), dt):
+    """Velocity gradient (Eq. 6), strain increment (Eq. 7) and area of the element
+    (a, b, c) on the mid-step configuration x − ½Δt·v: Δθ·area is then exactly the
+    area change of the step (the area is quadratic in the positions)."""
+    va, vb, vc = vel[a], vel[b], vel[c]
+    h = 0.5 * dt
+    ya, yb, yc = pos[a] - h * va, pos[b] - h * vb, pos[c] - h * vc
+    grad = fvm.velocity_gradient(ya, yb, yc, va, vb, vc)
+    return grad, fvm.strain_increment(grad, dt), fvm.area(ya, yb, yc)
 
 
 @ti.func
@@ -1259,22 +1263,15 @@ def stresses_retry(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
         s = code & 15
         b = elem[a, s, 0]
         c = elem[a, s, 1]
-        xa, xb, xc = pos[a], pos[b], pos[c]
-        va, vb, vc = vel[a], vel[b], vel[c]
-        h = 0.5 * dt
-        grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
-        de = fvm.strain_increment(grad, dt)
-        ea = (xb - h * vb) - (xa - h * va)
-        eb = (xc - h * vc) - (xa - h * va)
-        area = 0.5 * (ea[0] * eb[1] - ea[1] * eb[0])
+        grad, de, area = _kinematics(a, b, c, pos, vel, dt)
         M = pmat[a]
         failed = 0
         if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
             failed = 1
         sig, eps, flag = mc_correct_state(esig[a, s], matp, M, failed)
         esig[a, s] = sig
-        _finish(a, s, M, sig, eps, flag, de, area, ncov[a, s], xa, xb, xc, matp, emult,
-                efor, ede, dt, eos)
+        _finish(a, s, M, sig, eps, flag, de, area, ncov[a, s], pos[a], pos[b], pos[c], matp,
+                emult, efor, ede, dt, eos)
 
 
 @ti.kernel

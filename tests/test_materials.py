@@ -22,22 +22,17 @@ E, NU, C, PHI, T = 30e9, 0.25, 3e6, 40.0, 1e6
 
 @ti.kernel
 def _correct(matp: ti.types.ndarray(), m: ti.i32, failed: ti.i32, s: ti.types.ndarray(),
-             out: ti.types.ndarray(), eps: ti.types.ndarray(), flag: ti.types.ndarray()):
+             out: ti.types.ndarray(), eps: ti.types.ndarray(), flag: ti.types.ndarray(),
+             fast: ti.template()):
     for i in range(s.shape[0]):
         v = ti.Vector([s[i, 0], s[i, 1], s[i, 2], s[i, 3]])
-        o, e, f = mc_correct_state(v, matp, m, failed)
-        for k in ti.static(range(4)):
-            out[i, k] = o[k]
-        eps[i] = e
-        flag[i] = f
-
-
-@ti.kernel
-def _correct_fast(matp: ti.types.ndarray(), m: ti.i32, failed: ti.i32, s: ti.types.ndarray(),
-                  out: ti.types.ndarray(), eps: ti.types.ndarray(), flag: ti.types.ndarray()):
-    for i in range(s.shape[0]):
-        v = ti.Vector([s[i, 0], s[i, 1], s[i, 2], s[i, 3]])
-        o, e, f = mc_correct_fast(v, matp, m, failed)
+        o = v
+        e = 0.0
+        f = 0
+        if ti.static(fast):
+            o, e, f = mc_correct_fast(v, matp, m, failed)
+        else:
+            o, e, f = mc_correct_state(v, matp, m, failed)
         for k in ti.static(range(4)):
             out[i, k] = o[k]
         eps[i] = e
@@ -52,7 +47,7 @@ def correct(materials, trials, m=0, failed=0, fast=False):
     out = np.zeros_like(s)
     eps = np.zeros(len(s))
     flag = np.zeros(len(s), dtype=np.int32)
-    (_correct_fast if fast else _correct)(matp, m, failed, s, out, eps, flag)
+    _correct(matp, m, failed, s, out, eps, flag, fast)
     return out, eps, flag
 
 
