@@ -1397,7 +1397,12 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 c = code & 3
                 r = efor[code >> 6, (code >> 2) & 15]
                 mw = r[15]
-                f += mw * ti.Vector([r[2 * c], r[2 * c + 1]])
+                fc = ti.Vector([r[0], r[1]])
+                if c == 1:
+                    fc = ti.Vector([r[2], r[3]])
+                elif c == 2:
+                    fc = ti.Vector([r[4], r[5]])
+                f += mw * fc
                 ssum += mw * ti.Vector([r[6], r[7], r[8], r[9]])
                 dsum += mw * ti.Vector([r[10], r[11], r[12]])
                 psum += mw * r[13]
