@@ -626,12 +626,14 @@ def _mc_return(s, matp: ti.template(), M, failed, fallback: ti.template()):
         # sorted: i1 (most compressive), i3 (most tensile)
         i1 = 0
         i3 = 1
+        s1 = p[0]
+        s3 = p[1]
         if p[2] < p[0]:
             i1 = 2
+            s1 = p[2]
         elif p[2] > p[1]:
             i3 = 2
-        s1 = p[i1]
-        s3 = p[i3]
+            s3 = p[2]
         fs = s1 - s3 * nphi + 2.0 * coh * sq
         ft = s3 - ten
         if fs < 0.0 or ft > 0.0:
@@ -641,55 +643,66 @@ def _mc_return(s, matp: ti.template(), M, failed, fallback: ti.template()):
             ap = ti.sqrt(1.0 + nphi * nphi) + nphi
             sp = ten * nphi - 2.0 * coh * sq
             h = s3 - ten + ap * (s1 - sp)
-            act = ti.Vector([0, 0, 0])
-            nact = 1
-            if h <= 0.0 and fs < 0.0:
-                k = 2 * i1 + i3          # shear plane (i1, i3)
-                if i3 > i1:
-                    k -= 1
-                act[0] = k
+            # FLAC's one-plane return, in closed form: Δγ = F/(n·D m), q = p − Δγ D m
+            # with D m = (α1 − α2) m + α2 (Σ m) (1, 1, 1)
+            g1 = 0.0
+            d1 = 0.0       # (D m) at i1, i3 and the third value
+            d3 = 0.0
+            d2 = 0.0
+            shear = h <= 0.0 and fs < 0.0
+            if shear:
+                # plane (i1, i3): F = N_φ s_i3 − s_i1 − 2c√N_φ = −f_s, m_i1 = −1, m_i3 = N_ψ
+                d2 = a2 * (npsi - 1.0)
+                d1 = d2 - (a1 - a2)
+                d3 = d2 + (a1 - a2) * npsi
+                g1 = -fs / (nphi * d3 - d1)
+                # Δe^ps = Δγ·sqrt(½ |m − mean(m)|²)
+                mu = (npsi - 1.0) / 3.0
+                eps = g1 * ti.sqrt(0.5 * ((1.0 + mu) * (1.0 + mu) + (npsi - mu) * (npsi - mu)
+                                          + mu * mu))
+                flag = SHEAR_FAILURE
             else:
-                act[0] = 6 + i3
-            # FLAC's one-plane return
-            nk, ck, mk = _plane(act[0], nphi, npsi, sq, coh, ten)
-            dk = _dmul(mk, a1, a2)
-            A = nk.dot(dk)
+                # tension plane i3: F = s_i3 − T, m_i3 = 1
+                d1 = a2
+                d2 = a2
+                d3 = a1
+                g1 = ft / a1
+                flag = TENSION_FAILURE
+            q = ti.Vector([0.0, 0.0, 0.0])
+            for k in ti.static(range(3)):
+                dk = d2
+                if k == i1:
+                    dk = d1
+                elif k == i3:
+                    dk = d3
+                q[k] = p[k] - g1 * dk
             ok = 0
-            g = ti.Vector([0.0, 0.0, 0.0])
-            q = p
-            if A != 0.0:
-                g[0] = (nk.dot(p) + ck) / A
-                q = p - g[0] * dk
-                if g[0] >= 0.0 and _admissible(q, nphi, sq, coh, ten, tol):
-                    ok = 1
+            if g1 >= 0.0 and _admissible(q, nphi, sq, coh, ten, tol):
+                ok = 1
             # FLAC's return not admissible: the first admissible active set, by size
             if ti.static(fallback):
                 if ok == 0:
-                    act0 = act
-                    g0 = g
-                    q0 = q
-                    ok, act, nact, g, q = _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2,
-                                                            tol)
-                    if ok == 0:          # none found (not expected): keep FLAC's return
-                        act = act0
-                        nact = 1
-                        g = g0
-                        q = q0
-            # plastic strains of the shear planes, failure type
-            eps_s = ti.Vector([0.0, 0.0, 0.0])
-            shear_part = 0
-            for c in ti.static(range(3)):
-                if c < nact:
-                    nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
-                    if act[c] < 6:
-                        eps_s += g[c] * mc
-                        shear_part = 1
-            em = (eps_s[0] + eps_s[1] + eps_s[2]) / 3.0
-            dev = eps_s - em * ti.Vector([1.0, 1.0, 1.0])
-            eps = ti.sqrt(0.5 * dev.dot(dev))
-            flag = TENSION_FAILURE
-            if shear_part == 1:
-                flag = SHEAR_FAILURE
+                    ok2, act, nact, g, q2 = _first_admissible(p, nphi, npsi, sq, coh, ten, a1,
+                                                              a2, tol)
+                    if ok2 == 0:         # none found (not expected): keep FLAC's return
+                        eps = ti.abs(eps)
+                    else:
+                        q = q2
+                        # plastic strains of the shear planes, failure type
+                        eps_s = ti.Vector([0.0, 0.0, 0.0])
+                        shear_part = 0
+                        for c in ti.static(range(3)):
+                            if c < nact:
+                                nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
+                                if act[c] < 6:
+                                    eps_s += g[c] * mc
+                                    shear_part = 1
+                        em = (eps_s[0] + eps_s[1] + eps_s[2]) / 3.0
+                        dev = eps_s - em * ti.Vector([1.0, 1.0, 1.0])
+                        eps = ti.sqrt(0.5 * dev.dot(dev))
+                        flag = TENSION_FAILURE
+                        if shear_part == 1:
+                            flag = SHEAR_FAILURE
             # back to x–y
             cn = 0.5 * (q[0] + q[1])
             rn = 0.5 * (q[1] - q[0])
