@@ -1,7 +1,7 @@
 """PCMM throughput: a Mohr–Coulomb column collapsing under gravity.
 
 A column of PCMM particles (square lattice, R = 1 cm, δ = R, 200 × 200 = 40,000
-particles by default; 2 m wide and high) of a weak Mohr–Coulomb soil (ρ = 2000,
+particles by default; 4 m wide and high) of a weak Mohr–Coulomb soil (ρ = 2000,
 E = 10 MPa, ν = 0.3, c = 1 kPa, φ = 30°, T = 0.5 kPa, brittle) stands on a
 frictional floor with no side support: it yields, elements are deleted and
 created as it slumps and spreads, and touching particles that share no element
