@@ -913,6 +913,18 @@ def displacements(pos: ti.types.ndarray(), pmat: ti.types.ndarray(),
                 pu[i] = pos[i] - xref[i]
 
 
+@ti.func
+def _stress_of(i, s, esig: ti.template(), emult: ti.template(), ecopy: ti.template()):
+    """Last step's stress of the element in i's slot s: its own when it is the
+    computed copy, else the computed copy's (``ecopy``; copies' own ``esig`` is kept
+    only where it is read, see :func:`copies`)."""
+    out = esig[i, s]
+    if emult[i, s] == 0:
+        code = ecopy[i, s]
+        out = esig[code >> 4, code & 15]
+    return out
+
+
 @ti.kernel
 def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                      pmat: ti.types.ndarray(), mtol: ti.types.ndarray(),
@@ -923,6 +935,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                      earea: ti.types.ndarray(), esig: ti.types.ndarray(),
                      elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
                      ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(),
+                     emult: ti.types.ndarray(), ecopy: ti.types.ndarray(),
                      pu: ti.types.ndarray(), pbud: ti.types.ndarray(),
                      prb: ti.types.ndarray(), pflags: ti.types.ndarray(),
                      serial: ti.template()):
@@ -937,7 +950,9 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
     below slack − W (``pbud``; |x(t) − x(t_b)| ≤ u(t) + u(t_b)); otherwise, and at the
     start of an epoch, it rebuilds (``prb`` = 1). A rebuilt particle keeps its last
     elements and their stresses in the ``_old`` arrays and points each new slot at
-    the old slot of the same element (``esrc``, −1 for a new one).
+    the old slot of the same element (``esrc``, −1 for a new one); the stress of a
+    copy is read from its computed copy (``emult``, ``ecopy`` of last step, see
+    :func:`copies`; nothing writes ``esig`` here).
     """
     new = pflags[P_NEW] != 0
     built = pflags[P_BUILT] != 0
@@ -990,7 +1005,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                 for s in range(ecnt[i]):
                     elem_old[i, s, 0] = elem[i, s, 0]
                     elem_old[i, s, 1] = elem[i, s, 1]
-                    esig_old[i, s] = esig[i, s]
+                    esig_old[i, s] = _stress_of(i, s, esig, emult, ecopy)
                 r, rs = _ring(i, xi, cnt, pos, nbr, ring, rang)
                 ne, cs = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
                 ecnt[i] = ne
@@ -1033,15 +1048,28 @@ def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types
 @ti.kernel
 def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
            emult: ti.types.ndarray(), ecopy: ti.types.ndarray(), pdirty: ti.types.ndarray(),
-           serial: ti.template()):
+           prb: ti.types.ndarray(), esig: ti.types.ndarray(), serial: ti.template()):
     """1b. Copies: a triangle created by k of its vertices is computed once, by the
     copy of the lowest-index creator, with multiplicity k (``emult``; 0 for the other
     copies, whose ``ecopy`` = owner << 4 | slot of the computed copy). Copies have the
     same N_e, stress and forces, so every sum over elements weights the computed copy
-    by k. Only where something changed (``pdirty``)."""
+    by k. Only where something changed (``pdirty``).
+
+    A copy's own ``esig`` is brought up to date only where it can be read: here,
+    from last step's map and before the map changes, in the particles that kept
+    their elements but whose map can change (dirty ones; the stress pass reads a
+    copy's stress only there: a slot that becomes the computed copy, and the
+    neighbours of a rebuilt particle in :func:`_carried`); by
+    :func:`rebuild_elements` for a rebuilt particle's old slots; by
+    :func:`sync_copies` before the host reads them. The computed copies read here
+    are not written in this kernel."""
     ti.loop_config(serialize=serial)
     for a in range(pmat.shape[0]):
         if pdirty[a] != 0:
+            if prb[a] == 0:
+                for s in range(ecnt[a]):
+                    if emult[a, s] == 0:
+                        esig[a, s] = _stress_of(a, s, esig, emult, ecopy)
             for s in range(ecnt[a]):
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
@@ -1062,6 +1090,17 @@ def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.nd
                         slot = sc
                 emult[a, s] = mult if owner == a else 0
                 ecopy[a, s] = (owner << 4) | slot
+
+
+@ti.kernel
+def sync_copies(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(), ecopy: ti.types.ndarray(),
+                esig: ti.types.ndarray()):
+    """Every copy's ``esig`` from its computed copy (before the host reads or saves
+    the element stresses; see :func:`copies`)."""
+    for a in range(ecnt.shape[0]):
+        for s in range(ecnt[a]):
+            if emult[a, s] == 0:
+                esig[a, s] = _stress_of(a, s, esig, emult, ecopy)
 
 
 @ti.kernel
@@ -1346,17 +1385,13 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
 @ti.kernel
 def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
            matp: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
-           elem: ti.types.ndarray(), emult: ti.types.ndarray(), inc: ti.types.ndarray(),
-           icnt: ti.types.ndarray(), esig: ti.types.ndarray(), efor: ti.types.ndarray(),
-           ede: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
+           elem: ti.types.ndarray(), inc: ti.types.ndarray(), icnt: ti.types.ndarray(),
+           efor: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
            pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), pjwl: ti.types.ndarray(),
            enbr: ti.types.ndarray(), encnt: ti.types.ndarray(), cskip: ti.types.ndarray(),
-           pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), ecnt: ti.types.ndarray(),
-           ecopy: ti.types.ndarray(), ncov: ti.types.ndarray(), first: ti.i32,
+           pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), first: ti.i32,
            jwl: ti.template(), serial: ti.template()):
-    """3. Per particle (gathered, no atomics): its copies take their triangle's
-    stress and N_e from the computed copy (for next step's σ_old and the output);
-    force of its elements → xforce,
+    """3. Per particle (gathered, no atomics): force of its elements → xforce,
     stress = mean of its elements' σ (zero in none), strain and plastic shear
     strain += the means of the increments; the engine's pair slots (``cskip``,
     rewritten where the elements around the particle changed, at the start of an
@@ -1374,13 +1409,6 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
     built = pflags[P_BUILT] != 0
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
-        for s in range(ecnt[i]):
-            if emult[i, s] == 0:
-                code = ecopy[i, s]
-                o = code >> 4
-                so = code & 15
-                esig[i, s] = esig[o, so]
-                ncov[i, s] = ncov[o, so]
         redo = new or built or pdirty[i] != 0
         if redo:
             for k in range(encnt[i]):
@@ -1470,10 +1498,12 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     rebuild_elements(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
                      a["nbr"], a["ncnt"], a["ring"], a["rang"], a["elem"], a["ecnt"],
                      a["earea"], a["esig"], a["elem_old"], a["esig_old"], a["ecnt_old"],
-                     a["esrc"], a["pu"], a["pbud"], a["prb"], a["pflags"], serial)
+                     a["esrc"], a["emult"], a["ecopy"], a["pu"], a["pbud"], a["prb"],
+                     a["pflags"], serial)
     mark_dirty(a["pmat"], a["nbr"], a["ncnt"], a["pu"], a["prb"], a["pdirty"], a["unb"],
                serial)
-    copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], serial)
+    copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], a["prb"],
+           a["esig"], serial)
     incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
               a["picnt"], a["pdirty"], a["pflags"], serial)
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
@@ -1488,9 +1518,9 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],
                           a["efor"], a["ede"], a["pjwl"], dt, time, serial)
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
-           a["emult"], a["pinc"], a["picnt"], a["esig"], a["efor"], a["ede"], a["psig"],
-           a["peps"], a["pstate"], a["xforce"], a["pjwl"], e["nbr"], e["ncnt"], e["cskip"],
-           a["pdirty"], a["pflags"], a["ecnt"], a["ecopy"], a["ncov"], int(first), eos, serial)
+           a["pinc"], a["picnt"], a["efor"], a["psig"], a["peps"], a["pstate"], a["xforce"],
+           a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], a["pdirty"], a["pflags"], int(first),
+           eos, serial)
 
 
 @ti.func

@@ -142,6 +142,7 @@ def save(sim, path):
                         continue
                     fg.create_dataset(name, data=np.asarray(v, dtype=np.float64))
         if sim._cont is not None:
+            sim._cont.sync_copies()
             cg = f.create_group("continuum")
             for k, arr in sim._cont.a.items():
                 if k in _CONTINUUM_STATE:

@@ -217,6 +217,7 @@ class Continuum:
         a["pinc"] = ti.ndarray(ti.i32, (n, pcmm.MAX_INCIDENT))
         a["picnt"] = ti.ndarray(ti.i32, (n,))
         a["emult"] = ti.ndarray(ti.i32, (n, E))
+        a["emult"].fill(1)     # no copies known yet: every slot holds its own stress
         a["elem_old"] = ti.ndarray(ti.i32, (n, E, 2))
         a["esig_old"] = _arr(4, (n, E))
         a["ecnt_old"] = ti.ndarray(ti.i32, (n,))
@@ -648,7 +649,14 @@ class Continuum:
         self._alloc_lists()
         self.snap.pop("cand", None)
 
+    def sync_copies(self):
+        """Bring every copy's element stress up to date (kept lazily on the device,
+        see :func:`physics.pcmm.copies`), before the element stresses are saved."""
+        if self.has_pcmm:
+            pcmm.sync_copies(self.a["ecnt"], self.a["emult"], self.a["ecopy"], self.a["esig"])
+
     def take_snapshot(self):
+        self.sync_copies()
         for k in _SNAP:
             src = self.a[k]
             dst = self.snap.get(k)
@@ -666,6 +674,9 @@ class Continuum:
                 dst.copy_from(src)
         if self.snap.get("cand") is None:
             self.a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
+        # the map of copies belongs to the elements before the restore: every restored
+        # slot holds its own (synced) stress until the next step maps them again
+        self.a["emult"].fill(1)
         self._full = True
 
     # ------------------------------------------------------------------ reading
