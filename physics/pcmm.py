@@ -1026,15 +1026,18 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
 @ti.kernel
 def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
                pu: ti.types.ndarray(), prb: ti.types.ndarray(), pdirty: ti.types.ndarray(),
-               unb: ti.types.ndarray(), serial: ti.template()):
+               unb: ti.types.ndarray(), pstate: ti.types.ndarray(), pfail: ti.types.ndarray(),
+               serial: ti.template()):
     """1a. ``pdirty``: the particle or one of its Eq. 1 neighbours rebuilt (every
     vertex of an element containing i is one of them, so the multiplicities, the
     copies and the list of elements containing i can only have changed there);
-    ``unb``: the largest u over the particle and its Eq. 1 neighbours."""
+    ``unb``: the largest u over the particle and its Eq. 1 neighbours; ``pfail``:
+    the particle has failed (``pstate[i][1]``, compact for the stress pass)."""
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
         d = prb[i]
         u = 0.0
+        pfail[i] = 1 if pstate[i][1] > 0.0 else 0
         if pmat[i] >= 0:
             ui = pu[i]
             for q in range(ncnt[i]):
@@ -1183,7 +1186,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
              emult: ti.types.ndarray(), inc: ti.types.ndarray(), icnt: ti.types.ndarray(),
              ncov: ti.types.ndarray(), ebud: ti.types.ndarray(), esig: ti.types.ndarray(),
              efor: ti.types.ndarray(), ede: ti.types.ndarray(), psig: ti.types.ndarray(),
-             pstate: ti.types.ndarray(), rad: ti.types.ndarray(),
+             pfail: ti.types.ndarray(), rad: ti.types.ndarray(),
              elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
              ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(), prb: ti.types.ndarray(),
              pdirty: ti.types.ndarray(), unb: ti.types.ndarray(), pu: ti.types.ndarray(),
@@ -1237,7 +1240,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
                         de, matp[M, 2], matp[M, 3])
                     failed = 0
-                    if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
+                    if pfail[a] + pfail[b] + pfail[c] > 0:
                         failed = 1
                     sig, eps, flag = mc_correct_fast(sig, matp, M, failed)
                 esig[a, s] = sig
@@ -1289,7 +1292,7 @@ def stresses_retry(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                    elem: ti.types.ndarray(), emult: ti.types.ndarray(),
                    ncov: ti.types.ndarray(), esig: ti.types.ndarray(),
                    efor: ti.types.ndarray(), ede: ti.types.ndarray(),
-                   pstate: ti.types.ndarray(), eretry: ti.types.ndarray(), dt: ti.f64,
+                   pfail: ti.types.ndarray(), eretry: ti.types.ndarray(), dt: ti.f64,
                    eos: ti.template(), serial: ti.template()):
     """2b. The elements :func:`stresses` listed: their trial stress (in ``esig``)
     corrected with the full search of :func:`physics.materials.mc_correct_state`,
@@ -1305,7 +1308,7 @@ def stresses_retry(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
         grad, de, area = _kinematics(a, b, c, pos, vel, dt)
         M = pmat[a]
         failed = 0
-        if pstate[a][1] + pstate[b][1] + pstate[c][1] > 0.0:
+        if pfail[a] + pfail[b] + pfail[c] > 0:
             failed = 1
         sig, eps, flag = mc_correct_state(esig[a, s], matp, M, failed)
         esig[a, s] = sig
@@ -1501,18 +1504,18 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
                      a["esrc"], a["emult"], a["ecopy"], a["pu"], a["pbud"], a["prb"],
                      a["pflags"], serial)
     mark_dirty(a["pmat"], a["nbr"], a["ncnt"], a["pu"], a["prb"], a["pdirty"], a["unb"],
-               serial)
+               a["pstate"], a["pfail"], serial)
     copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], a["prb"],
            a["esig"], serial)
     incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
               a["picnt"], a["pdirty"], a["pflags"], serial)
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
              a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["efor"], a["ede"],
-             a["psig"], a["pstate"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
+             a["psig"], a["pfail"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
              a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], a["eretry"], dt,
              carry, eos, serial)
     stresses_retry(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["emult"], a["ncov"],
-                   a["esig"], a["efor"], a["ede"], a["pstate"], a["eretry"], dt, eos, serial)
+                   a["esig"], a["efor"], a["ede"], a["pfail"], a["eretry"], dt, eos, serial)
     if eos:
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],

@@ -228,6 +228,7 @@ class Continuum:
         a["pbud"] = ti.ndarray(ti.f64, (n,))
         a["prb"] = ti.ndarray(ti.i32, (n,))
         a["pdirty"] = ti.ndarray(ti.i32, (n,))
+        a["pfail"] = ti.ndarray(ti.i32, (n,))     # pstate[i][1] > 0, for the stress pass
         a["esrc"] = ti.ndarray(ti.i32, (n, E))
         a["ecopy"] = ti.ndarray(ti.i32, (n, E))
         a["ebud"] = ti.ndarray(ti.f64, (n, E))
