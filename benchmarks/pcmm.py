@@ -8,9 +8,12 @@ created as it slumps and spreads, and touching particles that share no element
 interact through the contact law. After the warm-up the timed steps are in the
 large-deformation regime.
 
-Prints particle-steps per second of the PCMM run and, measured in the same
-process on the same machine, of the DEM pack benchmark (``pack2d.py``'s
-workload), and their ratio:
+Prints particle-steps per second of the PCMM run and of the DEM pack benchmark
+(``pack2d.py``'s workload), and their ratio. The machine's speed drifts, so both
+run in the same process and are timed in alternating rounds (``--rounds``; each
+round times a share of the PCMM steps, then four times as many DEM steps); the
+rates printed are the medians over the rounds and the ratio is the median of the
+rounds' ratios, with its range:
 
     python benchmarks/pcmm.py --threads 2
     python benchmarks/pcmm.py --threads 1 --side 100      # 10,000 particles
@@ -39,19 +42,39 @@ def build(side=200, arch=None, threads=None):
     return sim
 
 
-def measure_pcmm(side, steps, warmup, arch, threads):
-    sim = build(side, arch, threads)
-    sim.run(steps=warmup)
+def _timed(sim, steps):
+    """Seconds for ``steps`` steps of ``sim`` (waiting for the device)."""
+    import taichi as ti
+    ti.sync()
     t = time.perf_counter()
     sim.run(steps=steps)
+    ti.sync()
+    return time.perf_counter() - t
+
+
+def measure(side, steps, warmup, arch, threads, rounds=5, dem=True):
+    """Rates (particle-steps/s) of the PCMM column and, if ``dem``, of the DEM pack,
+    timed in ``rounds`` alternating rounds after their warm-ups: (PCMM info, list of
+    PCMM rates, list of DEM rates, DEM particle count)."""
+    from benchmarks.pack2d import build as build_dem
+    sim = build(side, arch, threads)
+    sim.run(steps=warmup)
+    pack = None
+    if dem:
+        pack = build_dem(200, 200, arch, threads)
+        pack.run(steps=2000)
+    per = max(1, steps // rounds)
+    rates, dem_rates = [], []
+    for _ in range(rounds):
+        rates.append(sim.n_particles * per / _timed(sim, per))
+        if pack is not None:
+            dem_rates.append(pack.n_particles * 4 * per / _timed(pack, 4 * per))
     p = sim.particles.numpy()
-    el = time.perf_counter() - t
-    info = {"particles": sim.n_particles, "steps": steps, "seconds": el,
-            "rate": sim.n_particles * steps / el, "dt": sim.dt, "time": sim.time,
+    info = {"particles": sim.n_particles, "steps": per * rounds, "dt": sim.dt, "time": sim.time,
             "elements": len(sim.elements.numpy()["triangles"]),
             "failed_fraction": float(np.mean(p["failed"])),
             "spread": float(np.ptp(p["position"][:, 0]))}
-    return info
+    return info, rates, dem_rates, (pack.n_particles if pack is not None else 0)
 
 
 def main(argv=None):
@@ -59,21 +82,29 @@ def main(argv=None):
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--side", type=int, default=200, help="particles per row (side²)")
-    p.add_argument("--steps", type=int, default=500)
+    p.add_argument("--steps", type=int, default=500, help="timed PCMM steps, over all rounds")
     p.add_argument("--warmup", type=int, default=1500)
+    p.add_argument("--rounds", type=int, default=5,
+                   help="alternating timed rounds of the PCMM column and the DEM pack")
     p.add_argument("--arch", default=None)
     p.add_argument("--no-dem", action="store_true", help="skip the DEM pack reference")
     args = p.parse_args(argv)
-    from benchmarks.pack2d import measure as measure_dem
-    r = measure_pcmm(args.side, args.steps, args.warmup, args.arch, args.threads)
-    print(f"PCMM particles {r['particles']} steps {r['steps']} seconds {r['seconds']:.3f} "
+    if args.rounds < 1:
+        p.error(f"--rounds must be >= 1, got {args.rounds}")
+    r, rates, dem_rates, n_dem = measure(args.side, args.steps, args.warmup, args.arch,
+                                         args.threads, args.rounds, not args.no_dem)
+    rate = float(np.median(rates))
+    print(f"PCMM particles {r['particles']} steps {r['steps']} in {args.rounds} rounds "
           f"(t = {r['time']:.4g} s, dt = {r['dt']:.3g} s, {r['elements']} elements, "
           f"{100 * r['failed_fraction']:.0f} % failed, spread {r['spread']:.3f} m)")
-    print(f"PCMM tdem {args.threads} particle_steps_per_s {r['rate']:.0f}", flush=True)
-    if not args.no_dem:
-        n, rate, _ = measure_dem(200, 200, 2000, 2000, args.arch, args.threads)
-        print(f"DEM pack tdem {args.threads} particle_steps_per_s {rate:.0f} ({n} discs)")
-        print(f"ratio PCMM/DEM {r['rate'] / rate:.3f}")
+    print("PCMM rounds " + " ".join(f"{x:.0f}" for x in rates))
+    print(f"PCMM tdem {args.threads} particle_steps_per_s {rate:.0f}", flush=True)
+    if dem_rates:
+        ratios = np.array(rates) / np.array(dem_rates)
+        print("DEM pack rounds " + " ".join(f"{x:.0f}" for x in dem_rates))
+        print(f"DEM pack tdem {args.threads} particle_steps_per_s {np.median(dem_rates):.0f} "
+              f"({n_dem} discs)")
+        print(f"ratio PCMM/DEM {np.median(ratios):.3f} (rounds {ratios.min():.3f}-{ratios.max():.3f})")
 
 
 if __name__ == "__main__":
