@@ -29,10 +29,10 @@ Rules
 Storage (copies)
 ----------------
 Each particle A stores the elements it created in its own slots
-(``elem[A, s] = (i, i+1)``, s < ``ecnt[A]`` ≤ 12); the element is (A, i, i+1),
-counter-clockwise. The element list is the union of all slots, ordered by owner
-then slot, **copies included**: a triangle created by k of its vertices appears k
-times. Every sum over elements below runs over this list.
+(``elem[A, s] = (i, i+1)``, s < ``ecnt[A]`` ≤ 12, in increasing order of i); the
+element is (A, i, i+1), counter-clockwise. The element list is the union of all
+slots, ordered by owner then slot, **copies included**: a triangle created by k of
+its vertices appears k times. Every sum over elements below runs over this list.
 
 Superposition (Eq. 4)
 ---------------------
@@ -304,6 +304,20 @@ def _create(a, m, xa, ra, tol, pos: ti.template(), rad: ti.template(), ring: ti.
                 elem[a, cnt, 1] = c
                 earea[a, cnt] = 0.5 * twice
                 cnt += 1
+    # slots in increasing order of their first neighbour: the order (and so every sum
+    # over a particle's elements) is a function of the element set, not of where the
+    # ring was cut when it was built
+    for t in range(1, cnt):
+        k = t
+        while k > 0 and elem[a, k - 1, 0] > elem[a, k, 0]:
+            e0, e1, ar = elem[a, k, 0], elem[a, k, 1], earea[a, k]
+            elem[a, k, 0] = elem[a, k - 1, 0]
+            elem[a, k, 1] = elem[a, k - 1, 1]
+            earea[a, k] = earea[a, k - 1]
+            elem[a, k - 1, 0] = e0
+            elem[a, k - 1, 1] = e1
+            earea[a, k - 1] = ar
+            k -= 1
     return cnt, slack
 
 

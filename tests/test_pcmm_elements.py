@@ -175,7 +175,8 @@ def test_rules_hold_before_and_after_large_deformation(packings, systems, name):
 
 # ------------------------------------------------------------ against a reference
 def _reference_elements(x, r, tol):
-    """The creation rules in plain numpy, particle by particle."""
+    """The creation rules in plain numpy, particle by particle (each particle's
+    elements in increasing order of the first neighbour, the kernels' slot order)."""
     d2 = np.sum((x[None, :, :] - x[:, None, :]) ** 2, axis=2)
     cut = r[:, None] + r[None, :] + tol
     nb = d2 <= cut * cut
@@ -200,7 +201,8 @@ def _reference_elements(x, r, tol):
         cand = [(a, js[k], js[(k + 1) % m]) for k in range(m)] if m >= 2 else []
         if cand:
             ok = check_rules(x, r, tol, cand, rtol=0.0)["ok"]
-            out += [c for c, o in zip(cand, ok) if o]
+            # a particle's elements in increasing order of the first neighbour
+            out += sorted((c for c, o in zip(cand, ok) if o), key=lambda c: c[1])
     return np.array(out, dtype=np.int64).reshape(-1, 3)
 
 
