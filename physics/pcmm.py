@@ -939,6 +939,15 @@ def _stress_of(i, s, esig: ti.template(), emult: ti.template(), ecopy: ti.templa
     return out
 
 
+@ti.func
+def _refresh_copies(a, ecnt: ti.template(), emult: ti.template(), ecopy: ti.template(),
+                    esig: ti.template()):
+    """The stresses of a's copies from their computed copies (last step's map)."""
+    for s in range(ecnt[a]):
+        if emult[a, s] == 0:
+            esig[a, s] = _stress_of(a, s, esig, emult, ecopy)
+
+
 @ti.kernel
 def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                      pmat: ti.types.ndarray(), mtol: ti.types.ndarray(),
@@ -1084,9 +1093,7 @@ def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.nd
     for a in range(pmat.shape[0]):
         if pdirty[a] != 0:
             if prb[a] == 0:
-                for s in range(ecnt[a]):
-                    if emult[a, s] == 0:
-                        esig[a, s] = _stress_of(a, s, esig, emult, ecopy)
+                _refresh_copies(a, ecnt, emult, ecopy, esig)
             for s in range(ecnt[a]):
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
@@ -1115,9 +1122,7 @@ def sync_copies(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(), ecopy: ti.t
     """Every copy's ``esig`` from its computed copy (before the host reads or saves
     the element stresses; see :func:`copies`)."""
     for a in range(ecnt.shape[0]):
-        for s in range(ecnt[a]):
-            if emult[a, s] == 0:
-                esig[a, s] = _stress_of(a, s, esig, emult, ecopy)
+        _refresh_copies(a, ecnt, emult, ecopy, esig)
 
 
 @ti.kernel
