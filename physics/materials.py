@@ -524,7 +524,7 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
     nact = 1
     g = ti.Vector([0.0, 0.0, 0.0])
     q = p
-    for a in range(9):
+    for a in ti.static(range(9)):
         if ok == 0:
             da = ti.Vector([Dm[a, 0], Dm[a, 1], Dm[a, 2]])
             A = N[a, 0] * da[0] + N[a, 1] * da[1] + N[a, 2] * da[2]
@@ -538,6 +538,8 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
                         g = ti.Vector([ga, 0.0, 0.0])
                         q = qa
     for a in range(9):
+        if ok != 0:
+            break
         for b in range(a + 1, 9):
             if ok == 0:
                 na = ti.Vector([N[a, 0], N[a, 1], N[a, 2]])
@@ -562,7 +564,11 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
                             g = ti.Vector([g0, g1, 0.0])
                             q = qa
     for a in range(9):
+        if ok != 0:
+            break
         for b in range(a + 1, 9):
+            if ok != 0:
+                break
             for c in range(b + 1, 9):
                 if ok == 0:
                     na = ti.Vector([N[a, 0], N[a, 1], N[a, 2]])
