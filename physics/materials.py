@@ -116,7 +116,6 @@ from .validate import in_range, non_negative, positive
 MAT_WIDTH = 14
 ELASTIC, MOHR_COULOMB, FLUID, JWL_TYPE = 0, 1, 2, 3
 NO_FAILURE, SHEAR_FAILURE, TENSION_FAILURE = 0, 1, 2
-MC_RETRY = -1          # mc_correct_fast: redo with mc_correct_state
 
 
 def _n_angle(deg):
@@ -598,10 +597,18 @@ def _first_admissible(p, nphi, npsi, sq, coh, ten, a1, a2, tol):
 
 
 @ti.func
-def _mc_return(s, matp: ti.template(), M, failed, fallback: ti.template()):
-    """:func:`mc_correct_state` (``fallback`` True) or :func:`mc_correct_fast`
-    (False: where FLAC's one-plane return is not admissible, s unchanged with flag
-    MC_RETRY instead of the search of the active sets)."""
+def mc_correct_state(s, matp: ti.template(), M, failed):
+    """Mohr–Coulomb + tension cut-off correction of a trial stress (module docstring).
+
+    s: trial stress (σxx, σyy, σxy, σzz), tension-positive; M: row of ``matp``;
+    failed: nonzero when the particle has failed before (brittle softening then uses
+    the residual c_r, T_r of columns 9–10).
+    Returns (corrected stress, plastic shear strain increment Δe^ps ≥ 0, flag:
+    0 no failure, 1 shear (a shear plane is active, alone or at a corner with the
+    cut-off), 2 tension only). Elastic and Fluid rows return s unchanged. A kernel
+    doing brittle softening marks the particle failed once flag > 0.
+    A stress inside the surface is returned unchanged (bitwise).
+    """
     out = s
     eps = 0.0
     flag = NO_FAILURE
@@ -685,67 +692,35 @@ def _mc_return(s, matp: ti.template(), M, failed, fallback: ti.template()):
             ok = 0
             if g1 >= 0.0 and _admissible(q, nphi, sq, coh, ten, tol):
                 ok = 1
-            # FLAC's return not admissible: the first admissible active set, by size
-            if ti.static(fallback):
-                if ok == 0:
-                    ok2, act, nact, g, q2 = _first_admissible(p, nphi, npsi, sq, coh, ten, a1,
-                                                              a2, tol)
-                    if ok2 == 0:         # none found (not expected): keep FLAC's return
-                        eps = ti.abs(eps)
-                    else:
-                        q = q2
-                        # plastic strains of the shear planes, failure type
-                        eps_s = ti.Vector([0.0, 0.0, 0.0])
-                        shear_part = 0
-                        for c in ti.static(range(3)):
-                            if c < nact:
-                                nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
-                                if act[c] < 6:
-                                    eps_s += g[c] * mc
-                                    shear_part = 1
-                        em = (eps_s[0] + eps_s[1] + eps_s[2]) / 3.0
-                        dev = eps_s - em * ti.Vector([1.0, 1.0, 1.0])
-                        eps = ti.sqrt(0.5 * dev.dot(dev))
-                        flag = TENSION_FAILURE
-                        if shear_part == 1:
-                            flag = SHEAR_FAILURE
+            # FLAC's return not admissible (near a corner or the apex of the surface):
+            # the first admissible active set, by size
+            if ok == 0:
+                ok2, act, nact, g, q2 = _first_admissible(p, nphi, npsi, sq, coh, ten, a1,
+                                                          a2, tol)
+                if ok2 == 0:         # none found (not expected): keep FLAC's return
+                    eps = ti.abs(eps)
+                else:
+                    q = q2
+                    # plastic strains of the shear planes, failure type
+                    eps_s = ti.Vector([0.0, 0.0, 0.0])
+                    shear_part = 0
+                    for c in ti.static(range(3)):
+                        if c < nact:
+                            nc, kc, mc = _plane(act[c], nphi, npsi, sq, coh, ten)
+                            if act[c] < 6:
+                                eps_s += g[c] * mc
+                                shear_part = 1
+                    em = (eps_s[0] + eps_s[1] + eps_s[2]) / 3.0
+                    dev = eps_s - em * ti.Vector([1.0, 1.0, 1.0])
+                    eps = ti.sqrt(0.5 * dev.dot(dev))
+                    flag = TENSION_FAILURE
+                    if shear_part == 1:
+                        flag = SHEAR_FAILURE
             # back to x–y
             cn = 0.5 * (q[0] + q[1])
             rn = 0.5 * (q[1] - q[0])
             out = ti.Vector([cn + rn * c2, cn - rn * c2, rn * s2, q[2]])
-            if ti.static(not fallback):
-                if ok == 0:
-                    out = s
-                    eps = 0.0
-                    flag = MC_RETRY
     return out, eps, flag
-
-
-@ti.func
-def mc_correct_state(s, matp: ti.template(), M, failed):
-    """Mohr–Coulomb + tension cut-off correction of a trial stress (module docstring).
-
-    s: trial stress (σxx, σyy, σxy, σzz), tension-positive; M: row of ``matp``;
-    failed: nonzero when the particle has failed before (brittle softening then uses
-    the residual c_r, T_r of columns 9–10).
-    Returns (corrected stress, plastic shear strain increment Δe^ps ≥ 0, flag:
-    0 no failure, 1 shear (a shear plane is active, alone or at a corner with the
-    cut-off), 2 tension only). Elastic and Fluid rows return s unchanged. A kernel
-    doing brittle softening marks the particle failed once flag > 0.
-    A stress inside the surface is returned unchanged (bitwise).
-    """
-    return _mc_return(s, matp, M, failed, True)
-
-
-@ti.func
-def mc_correct_fast(s, matp: ti.template(), M, failed):
-    """:func:`mc_correct_state` without the search of the active sets: where FLAC's
-    one-plane return is not admissible (rare: near a corner of the surface) it
-    returns (s, 0, MC_RETRY), and the caller redoes that stress with
-    :func:`mc_correct_state` in a second pass. Where it returns another flag the
-    result is that of :func:`mc_correct_state` bitwise. Keeping the search out of
-    the element kernel keeps that kernel small (the search is most of its code)."""
-    return _mc_return(s, matp, M, failed, False)
 
 
 @ti.func

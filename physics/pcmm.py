@@ -91,8 +91,7 @@ from tdem import backend
 from tdem.errors import CapacityError, InputError
 
 from . import fvm
-from .materials import (FLUID, JWL_TYPE, MC_RETRY, fluid_pressure, jwl_pressure,
-                        mc_correct_fast, mc_correct_state)
+from .materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
 from .validate import positive
 
 MAX_ELEMENTS = 12        # elements a particle can create (pruned gaps are >= 30 deg)
@@ -1209,8 +1208,8 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
              elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
              ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(), prb: ti.types.ndarray(),
              pdirty: ti.types.ndarray(), unb: ti.types.ndarray(), pu: ti.types.ndarray(),
-             pflags: ti.types.ndarray(), eretry: ti.types.ndarray(), dt: ti.f64,
-             carry: ti.template(), eos: ti.template(), serial: ti.template()):
+             pflags: ti.types.ndarray(), dt: ti.f64, carry: ti.template(),
+             eos: ti.template(), serial: ti.template()):
     """2. Per computed element: N_e (probe rule; recounted where the elements around
     it changed or its vertices' neighbourhoods moved farther than the count's slack,
     ``ebud``, the same bookkeeping as :func:`rebuild_elements`), σ_old (the element's
@@ -1218,10 +1217,8 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     particles' stresses), Eqs. 6–11 with the Jaumann rotation (velocity gradient on
     the mid-step configuration, see :mod:`physics.blocks`), the constitutive
     correction (Eq. 12), nodal forces with the weight 1/N_e (Eqs. 13–14, sign
-    fixed). The rare Mohr–Coulomb stress whose one-plane return is not admissible
-    is listed in ``eretry`` (count first) and finished by :func:`stresses_retry`."""
+    fixed)."""
     new = pflags[P_NEW] != 0
-    eretry[0] = 0
     ti.loop_config(serialize=serial)
     for a in range(pmat.shape[0]):
         for s in range(ecnt[a]):
@@ -1261,15 +1258,10 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     failed = 0
                     if pfail[a] + pfail[b] + pfail[c] > 0:
                         failed = 1
-                    sig, eps, flag = mc_correct_fast(sig, matp, M, failed)
+                    sig, eps, flag = mc_correct_state(sig, matp, M, failed)
                 esig[a, s] = sig
-                if flag == MC_RETRY:
-                    # the trial stress, corrected by stresses_retry
-                    k = ti.atomic_add(eretry[0], 1)
-                    eretry[k + 1] = (a << 4) | s
-                else:
-                    _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp, emult,
-                            efor, ede, dt, eos)
+                _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp, emult,
+                        efor, ede, dt, eos)
 
 
 @ti.func
@@ -1303,36 +1295,6 @@ def _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp: ti.templ
         fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
     efor[a, s] = _record(fa, fb, fc, sig, de, eps, ti.cast(flag, ti.f64),
                          ti.cast(emult[a, s], ti.f64))
-
-
-@ti.kernel
-def stresses_retry(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
-                   pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
-                   elem: ti.types.ndarray(), emult: ti.types.ndarray(),
-                   ncov: ti.types.ndarray(), esig: ti.types.ndarray(),
-                   efor: ti.types.ndarray(), ede: ti.types.ndarray(),
-                   pfail: ti.types.ndarray(), eretry: ti.types.ndarray(), dt: ti.f64,
-                   eos: ti.template(), serial: ti.template()):
-    """2b. The elements :func:`stresses` listed: their trial stress (in ``esig``)
-    corrected with the full search of :func:`physics.materials.mc_correct_state`,
-    then the same end of step 2 (strain increment and area recomputed exactly as
-    :func:`stresses` computes them)."""
-    ti.loop_config(serialize=serial)
-    for k in range(eretry[0]):
-        code = eretry[k + 1]
-        a = code >> 4
-        s = code & 15
-        b = elem[a, s, 0]
-        c = elem[a, s, 1]
-        grad, de, area = _kinematics(a, b, c, pos, vel, dt)
-        M = pmat[a]
-        failed = 0
-        if pfail[a] + pfail[b] + pfail[c] > 0:
-            failed = 1
-        sig, eps, flag = mc_correct_state(esig[a, s], matp, M, failed)
-        esig[a, s] = sig
-        _finish(a, s, M, sig, eps, flag, de, area, ncov[a, s], pos[a], pos[b], pos[c], matp,
-                emult, efor, ede, dt, eos)
 
 
 @ti.kernel
@@ -1531,10 +1493,8 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
              a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["efor"], a["ede"],
              a["psig"], a["pfail"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
-             a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], a["eretry"], dt,
-             carry, eos, serial)
-    stresses_retry(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["emult"], a["ncov"],
-                   a["esig"], a["efor"], a["ede"], a["pfail"], a["eretry"], dt, eos, serial)
+             a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], dt, carry, eos,
+             serial)
     if eos:
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],

@@ -6,7 +6,7 @@ One step of a model with continua (:meth:`tdem.Simulation._one_step`):
       -> PCMM candidates (only after a list build)            physics.pcmm.candidates
       -> PCMM elements, stresses, nodal forces, gathered     physics.pcmm.update
          (displacements -> rebuild_elements -> mark_dirty -> copies -> incidence
-          -> stresses -> stresses_retry -> equation_of_state -> gather)
+          -> stresses -> equation_of_state -> gather)
       -> block element stresses and nodal forces            physics.blocks.update
       -> DEM contacts + element forces, leapfrog           tdem.step.step
       -> block nodes: damping, prescribed velocities, leapfrog   integrate_nodes
@@ -232,7 +232,6 @@ class Continuum:
         a["esrc"] = ti.ndarray(ti.i32, (n, E))
         a["ecopy"] = ti.ndarray(ti.i32, (n, E))
         a["ebud"] = ti.ndarray(ti.f64, (n, E))
-        a["eretry"] = ti.ndarray(ti.i32, (n * E + 1,))   # physics.pcmm.stresses_retry
         self._full = True
         a["pflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
         a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))

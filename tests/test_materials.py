@@ -12,8 +12,7 @@ import pytest
 import taichi as ti
 
 import tdem
-from physics.materials import (MAT_WIDTH, MC_RETRY, Elastic, Fluid, Material, MohrCoulomb,
-                               mc_correct_fast, mc_correct_state)
+from physics.materials import MAT_WIDTH, Elastic, Fluid, Material, MohrCoulomb, mc_correct_state
 from tdem import backend
 from tdem.errors import InputError
 
@@ -22,24 +21,17 @@ E, NU, C, PHI, T = 30e9, 0.25, 3e6, 40.0, 1e6
 
 @ti.kernel
 def _correct(matp: ti.types.ndarray(), m: ti.i32, failed: ti.i32, s: ti.types.ndarray(),
-             out: ti.types.ndarray(), eps: ti.types.ndarray(), flag: ti.types.ndarray(),
-             fast: ti.template()):
+             out: ti.types.ndarray(), eps: ti.types.ndarray(), flag: ti.types.ndarray()):
     for i in range(s.shape[0]):
         v = ti.Vector([s[i, 0], s[i, 1], s[i, 2], s[i, 3]])
-        o = v
-        e = 0.0
-        f = 0
-        if ti.static(fast):
-            o, e, f = mc_correct_fast(v, matp, m, failed)
-        else:
-            o, e, f = mc_correct_state(v, matp, m, failed)
+        o, e, f = mc_correct_state(v, matp, m, failed)
         for k in ti.static(range(4)):
             out[i, k] = o[k]
         eps[i] = e
         flag[i] = f
 
 
-def correct(materials, trials, m=0, failed=0, fast=False):
+def correct(materials, trials, m=0, failed=0):
     """Run mc_correct over trial stresses (N, 4) with material m of the table."""
     backend.init()
     matp = np.array([mat.row() for mat in materials], dtype=np.float64)
@@ -47,7 +39,7 @@ def correct(materials, trials, m=0, failed=0, fast=False):
     out = np.zeros_like(s)
     eps = np.zeros(len(s))
     flag = np.zeros(len(s), dtype=np.int32)
-    _correct(matp, m, failed, s, out, eps, flag, fast)
+    _correct(matp, m, failed, s, out, eps, flag)
     return out, eps, flag
 
 
@@ -350,27 +342,3 @@ def test_uniaxial_plane_strain_peak_is_the_mc_strength():
         peak = max(peak, -s[1])
         assert -s[1] <= ucs * (1 + 1e-9)
     assert peak == pytest.approx(ucs, rel=1e-6)
-
-
-@pytest.mark.parametrize("kw", [{}, dict(dilation_angle=10.0),
-                                dict(brittle=True, residual_cohesion=0.0)])
-def test_fast_correction_is_the_full_one_or_asks_again(kw):
-    """mc_correct_fast (the element kernels' first pass) gives mc_correct_state's
-    result bitwise wherever it does not return MC_RETRY, and returns the trial
-    stress unchanged where it does; random trials, many of them near the apex."""
-    rng = np.random.default_rng(7)
-    scale = np.array([4e6, 4e6, 3e6, 4e6])
-    trials = np.concatenate([rng.normal(0.0, 1.0, (3000, 4)) * scale,
-                             rng.normal(0.0, 1.0, (1000, 4)) * scale + 3e6])
-    mat = mc(**kw)
-    failed = 1 if kw.get("brittle") else 0
-    full = correct([mat], trials, failed=failed)
-    fast = correct([mat], trials, failed=failed, fast=True)
-    retry = fast[2] == MC_RETRY
-    assert 0 < retry.sum() < len(trials)
-    assert np.array_equal(fast[0][~retry], full[0][~retry])
-    assert np.array_equal(fast[1][~retry], full[1][~retry])
-    assert np.array_equal(fast[2][~retry], full[2][~retry])
-    assert np.array_equal(fast[0][retry], trials[retry])
-    # a retried trial is one that fails (the full return moves it)
-    assert np.all(full[2][retry] > 0)
