@@ -25,6 +25,9 @@ import tdem
 from . import _common as common
 
 COLORS = {"regular": "C0", "cross": "C1", "random": "C2", "fvm": "C3", "fvm_cross": "C4"}
+# open markers of different shapes, so that models that agree stay visible on top of
+# each other
+MARKERS = {"regular": "s", "cross": "^", "random": "o", "fvm": "D", "fvm_cross": "v"}
 LABELS = {"regular": "PCMM regular", "cross": "PCMM cross", "random": "PCMM random",
           "fvm": "FVM regular mesh", "fvm_cross": "FVM cross mesh"}
 

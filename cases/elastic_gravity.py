@@ -305,16 +305,17 @@ def plots(runs, out, ref_curves=None):
     _pcmm.plot_models(runs, out / "fig7_8_models.png",
                       title="Models and initial PCMM element systems (paper Figs. 7-8)")
     for key, fname, label, ana in (
-            ("uy", "fig9_displacement.png", "vertical displacement (m)", uy_analytic),
+            ("uy", "fig9_displacement.png", "vertical displacement (mm)", uy_analytic),
             ("syy", "fig10_stress.png", "vertical stress σ_yy (kPa)", sigma_target)):
-        k = 1.0 if key == "uy" else 1e-3          # stresses plotted in kPa
+        k = 1e3 if key == "uy" else 1e-3          # displacements in mm, stresses in kPa
         fig, ax = plt.subplots(figsize=(5, 5))
         for m in runs:
             prof = k * (m.profile_uy if key == "uy" else m.profile_syy)
             mon = k * (m.mon_uy if key == "uy" else m.mon_syy)
             c = _pcmm.COLORS[m.name]
             ax.plot(prof, m.profile_y, color=c, lw=1, alpha=0.6)
-            ax.plot(mon, MONITOR_Y, "o", color=c, label=_pcmm.LABELS[m.name], ms=4)
+            ax.plot(mon, MONITOR_Y, _pcmm.MARKERS[m.name], color=c, mfc="none",
+                    label=_pcmm.LABELS[m.name], ms=6)
         yy = np.linspace(0, H, 50)
         ax.plot(k * ana(yy), yy, "k--", lw=1,
                 label="−ρg(H−y)" if key == "syy" else "free column (1D)")
