@@ -775,6 +775,7 @@ PFLAGS_INIT = (0, -1, 0, 0, 1, 0, 0, 0)
 EPOCH_REBUILT = 0.05   # a new epoch begins after a step that rebuilt this fraction
 EPOCH_RECOUNT = 0.10   # ... or recounted N_e of this many elements per particle
 FLUID_CORE = 0.75  # λ of fluid_core_force
+CARRIED = -1.0     # a pair history's overlap entry while elements carry the pair (_set_skip)
 MAX_INCIDENT = 64  # slots of a particle's list of the elements containing it
 
 
@@ -1373,16 +1374,18 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
            efor: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
            pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), pjwl: ti.types.ndarray(),
            enbr: ti.types.ndarray(), encnt: ti.types.ndarray(), cskip: ti.types.ndarray(),
-           pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), first: ti.i32,
-           jwl: ti.template(), serial: ti.template()):
+           hist: ti.types.ndarray(), prop: ti.types.ndarray(), pdirty: ti.types.ndarray(),
+           pflags: ti.types.ndarray(), first: ti.i32, jwl: ti.template(),
+           serial: ti.template()):
     """3. Per particle (gathered, no atomics): force of its elements → xforce,
     stress = mean of its elements' σ (zero in none), strain and plastic shear
     strain += the means of the increments; the engine's pair slots (``cskip``,
     rewritten where the elements around the particle changed, at the start of an
     epoch and at the first two steps): 1 for two particles that are corners of a
-    common element (no DEM contact: the element carries their interaction; the
-    contact law records their overlap, from which it counts when it takes over, see
-    :func:`tdem.step.pair_contact`), and for same-body Fluid or JWL neighbours
+    common element (no DEM contact: the element carries their interaction; when it
+    stops doing so, :func:`_set_skip` records their overlap in the pair's history,
+    from which the contact law counts, see :func:`tdem.step.pair_contact`), and for
+    same-body Fluid or JWL neighbours
     (:func:`fluid_core_force`); 2, at the first step only, for the other same-body
     Eq. 1 neighbours (the contact law starts from their initial overlap: a touching
     pair left out of the elements by the angular pruning does not push apart). All
@@ -1394,9 +1397,6 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
         redo = new or built or pdirty[i] != 0
-        if redo:
-            for k in range(encnt[i]):
-                cskip[i, k] = 0
         if pmat[i] >= 0:
             f = ti.Vector([0.0, 0.0])
             ssum = ti.Vector([0.0, 0.0, 0.0, 0.0])
@@ -1428,13 +1428,15 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 q = 0
                 for k in range(encnt[i]):
                     j = enbr[i, k]
+                    skip = 0
                     while q < ncnt[i] and nbr[i, q] < j:
                         q += 1
                     if q < ncnt[i] and nbr[i, q] == j:
                         if fluid or _shares_element(i, j, inc, icnt, elem):
-                            cskip[i, k] = 1
+                            skip = 1
                         elif first != 0:
-                            cskip[i, k] = 2
+                            skip = 2
+                    _set_skip(i, k, j, skip, pos, prop, cskip, hist)
             if fluid:
                 # Fluid and JWL products: same-body Eq. 1 neighbours never meet through
                 # the contact law (no friction between fluid particles, and no force
@@ -1464,6 +1466,28 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
             pstate[i] = st
         else:
             xforce[i] = ti.Vector([0.0, 0.0])
+            if redo:
+                for k in range(encnt[i]):
+                    _set_skip(i, k, enbr[i, k], 0, pos, prop, cskip, hist)
+
+
+@ti.func
+def _set_skip(i, k, j, skip, pos: ti.template(), prop: ti.template(), cskip: ti.template(),
+              hist: ti.template()):
+    """Pair slot k of i (partner j) takes the mark ``skip`` (see :func:`gather`). The
+    pair's history says whether elements carried it at the last mark: its overlap
+    entry (4) is CARRIED (< 0) then, an overlap ≥ 0 otherwise. A pair that elements
+    stop carrying starts the contact law afresh, counting from its overlap now
+    (:func:`tdem.step.pair_contact`), so that the law takes over without a jump."""
+    cskip[i, k] = skip
+    h = hist[i, k]
+    if skip == 1:
+        if h[4] >= 0.0:
+            h[4] = CARRIED
+            hist[i, k] = h
+    elif h[4] < 0.0:
+        u = prop[i][0] + prop[j][0] - (pos[j] - pos[i]).norm()
+        hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, ti.max(u, 0.0)])
 
 
 def update(a, e, dt, time, first, full, carry, eos, serial):
@@ -1501,7 +1525,8 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
                           a["efor"], a["ede"], a["pjwl"], dt, time, serial)
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
            a["pinc"], a["picnt"], a["efor"], a["psig"], a["peps"], a["pstate"], a["xforce"],
-           a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], a["pdirty"], a["pflags"], int(first),
+           a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], e["hist"], e["prop"], a["pdirty"],
+           a["pflags"], int(first),
            eos, serial)
 
 

@@ -65,8 +65,9 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     rj = pj[0]
     u_geo = ri + rj - dist
     # a pair that shared PCMM elements until recently counts its overlap from the
-    # overlap it had then (hist[4], lowered as the two separate): the contact law
-    # takes over from the elements without a force jump (no energy from nowhere)
+    # overlap it had when they stopped carrying it (hist[4], recorded by
+    # physics.pcmm.gather, lowered as the two separate): the contact law takes over
+    # from the elements without a force jump (no energy from nowhere)
     u0 = ti.min(hist[i, k][4], ti.max(u_geo, 0.0))
     u = u_geo - u0
     f = ti.Vector([0.0, 0.0])
@@ -248,10 +249,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             if ti.static(continuum):
                 skip = cskip[i, k]
             if skip == 1:
-                # the elements carry this pair: remember its overlap (see pair_contact)
-                j = nbr[i, k]
-                u = pi[0] + prop[j][0] - (pos[j] - xi).norm()
-                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, ti.max(u, 0.0)])
+                # the elements carry this pair (its history is kept by
+                # physics.pcmm.gather)
                 if ti.static(detail):
                     cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
             else:

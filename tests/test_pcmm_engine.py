@@ -302,3 +302,34 @@ def test_checkpoint_while_elements_die_and_are_born_restarts_exactly(tmp_path):
     assert np.array_equal(ea["triangles"], ec["triangles"])
     assert np.array_equal(ea["stress"], ec["stress"])
     assert np.abs(ea["stress"]).max() > 0.0
+
+
+def test_contact_law_takes_over_from_a_dying_element_without_a_jump():
+    """Two overlapping particles held still share an element with a third that is
+    pulled away: when the element dies the contact law takes over counting from
+    their overlap at that moment (no force, although they overlap by 2 mm), and then
+    pushes back on any further overlap with k_n."""
+    r, kn = 0.01, 1e6
+    pos = np.array([[0.0, 0.0], [0.018, 0.0], [0.009, 0.0156]])
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.3, progress=False)
+    sim.add_particles(pos, np.full(3, r), material=tdem.Elastic(1000.0, 1e6, 0.25),
+                      tolerance=0.001, contact=tdem.LinearContact(kn=kn, ks=kn, friction=0.0))
+    sim.fix_particles([0, 1], vx=0.0, vy=0.0)
+    sim.fix_particles([2], vx=0.0, vy=5.0)
+    sim.run(steps=2)
+    assert len(sim.elements.numpy()["triangles"]) > 0
+    assert np.abs(sim.particles.numpy()["force"][:2]).max() > 100.0   # the element pulls
+    sim.run(steps=8)                          # particle 2 has left: the element is gone
+    assert len(sim.elements.numpy()["triangles"]) == 0
+    assert np.abs(sim.particles.numpy()["force"][:2]).max() == 0.0
+    v, n = 0.01, 20
+    sim.fix_particles([1], vx=-v, vy=0.0)
+    sim.run(steps=n)
+    c = sim.contacts.numpy()
+    assert c["pairs"].tolist() == [[0, 1]]
+    # the counted overlap is what was added since the takeover (the force of step n
+    # is computed before its move), not the 2 mm they overlap in all
+    assert c["overlap"][0] == pytest.approx((n - 1) * v * sim.dt, rel=1e-9)
+    assert c["normal"][0] == pytest.approx(kn * c["overlap"][0], rel=1e-9)
+    geo = 2 * r - np.linalg.norm(np.diff(sim.particles.numpy()["position"][:2], axis=0))
+    assert geo > 0.0019
