@@ -1385,13 +1385,12 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
     common element (no DEM contact: the element carries their interaction; when it
     stops doing so, :func:`_set_skip` records their overlap in the pair's history,
     from which the contact law counts, see :func:`tdem.step.pair_contact`), and for
-    same-body Fluid or JWL neighbours
-    (:func:`fluid_core_force`); 2, at the first step only, for the other same-body
-    Eq. 1 neighbours (the contact law starts from their initial overlap: a touching
-    pair left out of the elements by the angular pruning does not push apart). All
-    other touching pairs — sharing no element, whether in elements or not, same
-    body or not — meet through the contact law, so that particles cannot pass
-    through each other."""
+    same-body Fluid or JWL neighbours (:func:`fluid_core_force`); 2, at the first
+    step only, for the other same-body Eq. 1 neighbours (the contact law starts from
+    their initial overlap: a touching pair left out of the elements by the angular
+    pruning does not push apart). All other touching pairs — sharing no element,
+    whether in elements or not, same body or not — meet through the contact law, so
+    that particles cannot pass through each other."""
     new = pflags[P_NEW] != 0
     built = pflags[P_BUILT] != 0
     ti.loop_config(serialize=serial)
@@ -1526,8 +1525,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
            a["pinc"], a["picnt"], a["efor"], a["psig"], a["peps"], a["pstate"], a["xforce"],
            a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], e["hist"], e["prop"], a["pdirty"],
-           a["pflags"], int(first),
-           eos, serial)
+           a["pflags"], int(first), eos, serial)
 
 
 @ti.func
