@@ -1128,15 +1128,17 @@ def sync_copies(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(), ecopy: ti.t
 @ti.kernel
 def incidence(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
               elem: ti.types.ndarray(), ecnt: ti.types.ndarray(), emult: ti.types.ndarray(),
-              inc: ti.types.ndarray(), icnt: ti.types.ndarray(), pdirty: ti.types.ndarray(),
-              pflags: ti.types.ndarray(), serial: ti.template()):
+              inc: ti.types.ndarray(), icnt: ti.types.ndarray(), iwt: ti.types.ndarray(),
+              pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), serial: ti.template()):
     """1c. The computed elements containing each particle (owner << 6 | slot << 2 |
     which corner the particle is; the owner is the particle or one of its Eq. 1
-    neighbours), where something changed."""
+    neighbours) and the sum of their multiplicities (``iwt``: the number of
+    elements containing it, copies included), where something changed."""
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
         if pdirty[i] != 0:
             cnt = 0
+            wt = 0
             if pmat[i] >= 0:
                 for q in range(ncnt[i] + 1):
                     o = i
@@ -1147,20 +1149,59 @@ def incidence(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.
                             if cnt < MAX_INCIDENT:
                                 inc[i, cnt] = (o << 6) | (s << 2) | _corner(
                                     o, elem[o, s, 0], elem[o, s, 1], i)
+                                wt += emult[o, s]
                             cnt += 1
                 if cnt > MAX_INCIDENT:
                     ti.atomic_max(pflags[P_INC], cnt)
                     cnt = MAX_INCIDENT
             icnt[i] = cnt
+            iwt[i] = wt
+
+
+LOW32 = 0xFFFFFFFF          # the low 32 bits of an i64
 
 
 @ti.func
-def _record(fa, fb, fc, sig, de, eps, flag, mult):
-    """What the gather reads of a computed element, in one record (``efor``): the
-    nodal forces on its corners (0–5), its stress (6–9), strain increment (10–12),
-    plastic shear strain increment (13), failure flag (14), multiplicity (15)."""
-    return ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1], sig[0], sig[1], sig[2],
-                      sig[3], de[0], de[1], de[2], eps, flag, mult])
+def _pack2(x, y, mark):
+    """x and |y| rounded to f32, side by side in the bits of one f64 slot, with a
+    mark (0/1) in the place of the second's sign bit (integer operations: fast
+    math need not keep the sign of a zero)."""
+    lo = ti.cast(ti.bit_cast(ti.cast(x, ti.f32), ti.i32), ti.i64) & ti.i64(LOW32)
+    yb = ti.bit_cast(ti.cast(ti.abs(y), ti.f32), ti.i32) & 0x7FFFFFFF
+    hi = ti.cast(yb, ti.i64) << 32
+    if mark != 0:
+        hi = hi | (ti.cast(1, ti.i64) << 63)
+    return ti.bit_cast(lo | hi, ti.f64)
+
+
+@ti.func
+def _unpack2(v):
+    """x, |y| (as f64) and the mark of :func:`_pack2`."""
+    bits = ti.bit_cast(v, ti.i64)
+    lo = ti.bit_cast(ti.cast(bits & ti.i64(LOW32), ti.i32), ti.f32)
+    hi = ti.cast((bits >> 32) & 0x7FFFFFFF, ti.i32)
+    return ti.cast(lo, ti.f64), ti.cast(ti.bit_cast(hi, ti.f32), ti.f64), bits < 0
+
+
+@ti.func
+def _record(efor: ti.template(), a, s, fa, fb, fc, sig, de, eps, flag, mult):
+    """What the gather reads of a computed element: one 64-byte record per corner
+    (``efor[a, s, corner]``, so that a particle reads one cache line per element
+    containing it), each weighted by the multiplicity: the nodal force on the
+    corner (0–1), the stress (2–5), and, rounded to f32 and packed two to a slot
+    (:func:`_pack2`), the strain increment (6: xx, yy; 7: xy) and the plastic
+    shear strain increment (7, ≥ 0, marked for a failed element)."""
+    w = ti.cast(mult, ti.f64)
+    ws = w * sig
+    d01 = _pack2(w * de[0], w * de[1], 0)
+    d2e = _pack2(w * de[2], w * eps, flag)
+    for k in ti.static(range(3)):
+        f = fa
+        if ti.static(k == 1):
+            f = fb
+        elif ti.static(k == 2):
+            f = fc
+        efor[a, s, k] = ti.Vector([w * f[0], w * f[1], ws[0], ws[1], ws[2], ws[3], d01, d2e])
 
 
 @ti.func
@@ -1294,8 +1335,7 @@ def _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp: ti.templ
     if not _has_eos(matp, M):
         sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
         fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
-    efor[a, s] = _record(fa, fb, fc, sig, de, eps, ti.cast(flag, ti.f64),
-                         ti.cast(emult[a, s], ti.f64))
+    _record(efor, a, s, fa, fb, fc, sig, de, eps, flag, emult[a, s])
 
 
 @ti.kernel
@@ -1363,20 +1403,20 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                         q = d[6] / (d[0] + d[1])
                     sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
                     fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
-                    efor[a, s] = _record(fa, fb, fc, sig, de, d[3], d[4], ti.cast(emult[a, s],
-                                                                                  ti.f64))
+                    _record(efor, a, s, fa, fb, fc, sig, de, d[3], ti.cast(d[4], ti.i32),
+                            emult[a, s])
 
 
 @ti.kernel
 def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
            matp: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
            elem: ti.types.ndarray(), inc: ti.types.ndarray(), icnt: ti.types.ndarray(),
-           efor: ti.types.ndarray(), psig: ti.types.ndarray(), peps: ti.types.ndarray(),
-           pstate: ti.types.ndarray(), xforce: ti.types.ndarray(), pjwl: ti.types.ndarray(),
-           enbr: ti.types.ndarray(), encnt: ti.types.ndarray(), cskip: ti.types.ndarray(),
-           hist: ti.types.ndarray(), prop: ti.types.ndarray(), pdirty: ti.types.ndarray(),
-           pflags: ti.types.ndarray(), first: ti.i32, jwl: ti.template(),
-           serial: ti.template()):
+           iwt: ti.types.ndarray(), efor: ti.types.ndarray(), psig: ti.types.ndarray(),
+           peps: ti.types.ndarray(), pstate: ti.types.ndarray(), xforce: ti.types.ndarray(),
+           pjwl: ti.types.ndarray(), enbr: ti.types.ndarray(), encnt: ti.types.ndarray(),
+           cskip: ti.types.ndarray(), hist: ti.types.ndarray(), prop: ti.types.ndarray(),
+           pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), first: ti.i32,
+           jwl: ti.template(), serial: ti.template()):
     """3. Per particle (gathered, no atomics): force of its elements → xforce,
     stress = mean of its elements' σ (zero in none), strain and plastic shear
     strain += the means of the increments; the engine's pair slots (``cskip``,
@@ -1402,24 +1442,18 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
             dsum = ti.Vector([0.0, 0.0, 0.0])
             psum = 0.0
             hit = 0
-            cnt = 0.0
+            cnt = ti.cast(iwt[i], ti.f64)
             for q in range(icnt[i]):
                 code = inc[i, q]
-                c = code & 3
-                r = efor[code >> 6, (code >> 2) & 15]
-                mw = r[15]
-                fc = ti.Vector([r[0], r[1]])
-                if c == 1:
-                    fc = ti.Vector([r[2], r[3]])
-                elif c == 2:
-                    fc = ti.Vector([r[4], r[5]])
-                f += mw * fc
-                ssum += mw * ti.Vector([r[6], r[7], r[8], r[9]])
-                dsum += mw * ti.Vector([r[10], r[11], r[12]])
-                psum += mw * r[13]
-                if r[14] > 0.0:
+                r = efor[code >> 6, (code >> 2) & 15, code & 3]
+                f += ti.Vector([r[0], r[1]])
+                ssum += ti.Vector([r[2], r[3], r[4], r[5]])
+                dxx, dyy, _ = _unpack2(r[6])
+                dxy, ep, failed = _unpack2(r[7])
+                dsum += ti.Vector([dxx, dyy, dxy])
+                psum += ep
+                if failed:
                     hit = 1
-                cnt += mw
             kind_i = ti.cast(matp[pmat[i], 0], ti.i32)
             fluid = kind_i == FLUID or kind_i == JWL_TYPE
             if redo:
@@ -1512,7 +1546,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], a["prb"],
            a["esig"], serial)
     incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
-              a["picnt"], a["pdirty"], a["pflags"], serial)
+              a["picnt"], a["piwt"], a["pdirty"], a["pflags"], serial)
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
              a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["efor"], a["ede"],
              a["psig"], a["pfail"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
@@ -1523,9 +1557,9 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],
                           a["efor"], a["ede"], a["pjwl"], dt, time, serial)
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
-           a["pinc"], a["picnt"], a["efor"], a["psig"], a["peps"], a["pstate"], a["xforce"],
-           a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], e["hist"], e["prop"], a["pdirty"],
-           a["pflags"], int(first), eos, serial)
+           a["pinc"], a["picnt"], a["piwt"], a["efor"], a["psig"], a["peps"], a["pstate"],
+           a["xforce"], a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], e["hist"], e["prop"],
+           a["pdirty"], a["pflags"], int(first), eos, serial)
 
 
 @ti.func

@@ -204,7 +204,7 @@ class Continuum:
         a["earea"] = ti.ndarray(ti.f64, (n, E))
         a["ncov"] = ti.ndarray(ti.i32, (n, E))
         a["esig"] = _arr(4, (n, E))
-        a["efor"] = _arr(16, (n, E))
+        a["efor"] = _arr(8, (n, E, 3))
         a["ede"] = _arr(7, (n, E))
         a["psig"] = _arr(4, (n,))
         a["peps"] = _arr(3, (n,))
@@ -216,6 +216,7 @@ class Continuum:
         a["xforce"] = _arr(2, (n,))
         a["pinc"] = ti.ndarray(ti.i32, (n, pcmm.MAX_INCIDENT))
         a["picnt"] = ti.ndarray(ti.i32, (n,))
+        a["piwt"] = ti.ndarray(ti.i32, (n,))
         a["emult"] = ti.ndarray(ti.i32, (n, E))
         a["emult"].fill(1)     # no copies known yet: every slot holds its own stress
         a["elem_old"] = ti.ndarray(ti.i32, (n, E, 2))
