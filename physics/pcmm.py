@@ -1163,12 +1163,11 @@ LOW32 = 0xFFFFFFFF          # the low 32 bits of an i64
 
 @ti.func
 def _pack2(x, y, mark):
-    """x and |y| rounded to f32, side by side in the bits of one f64 slot, with a
-    mark (0/1) in the place of the second's sign bit (integer operations: fast
-    math need not keep the sign of a zero)."""
+    """x and y rounded to f32, side by side in the bits of one f64 slot; mark ≠ 0
+    sets the top bit, the sign of y, which must then be ≥ 0 (integer operations:
+    fast math need not keep the sign of a zero)."""
     lo = ti.cast(ti.bit_cast(ti.cast(x, ti.f32), ti.i32), ti.i64) & ti.i64(LOW32)
-    yb = ti.bit_cast(ti.cast(ti.abs(y), ti.f32), ti.i32) & 0x7FFFFFFF
-    hi = ti.cast(yb, ti.i64) << 32
+    hi = ti.cast(ti.bit_cast(ti.cast(y, ti.f32), ti.i32), ti.i64) << 32
     if mark != 0:
         hi = hi | (ti.cast(1, ti.i64) << 63)
     return ti.bit_cast(lo | hi, ti.f64)
@@ -1176,11 +1175,11 @@ def _pack2(x, y, mark):
 
 @ti.func
 def _unpack2(v):
-    """x, |y| (as f64) and the mark of :func:`_pack2`."""
+    """x and y (as f64) of :func:`_pack2`, and whether the top bit is set."""
     bits = ti.bit_cast(v, ti.i64)
     lo = ti.bit_cast(ti.cast(bits & ti.i64(LOW32), ti.i32), ti.f32)
-    hi = ti.cast((bits >> 32) & 0x7FFFFFFF, ti.i32)
-    return ti.cast(lo, ti.f64), ti.cast(ti.bit_cast(hi, ti.f32), ti.f64), bits < 0
+    hi = ti.bit_cast(ti.cast(bits >> 32, ti.i32), ti.f32)
+    return ti.cast(lo, ti.f64), ti.cast(hi, ti.f64), bits < 0
 
 
 @ti.func
@@ -1194,7 +1193,7 @@ def _record(efor: ti.template(), a, s, fa, fb, fc, sig, de, eps, flag, mult):
     w = ti.cast(mult, ti.f64)
     ws = w * sig
     d01 = _pack2(w * de[0], w * de[1], 0)
-    d2e = _pack2(w * de[2], w * eps, flag)
+    d2e = _pack2(w * de[2], ti.abs(w * eps), flag)
     for k in ti.static(range(3)):
         f = fa
         if ti.static(k == 1):
@@ -1451,7 +1450,7 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 dxx, dyy, _ = _unpack2(r[6])
                 dxy, ep, failed = _unpack2(r[7])
                 dsum += ti.Vector([dxx, dyy, dxy])
-                psum += ep
+                psum += ti.abs(ep)
                 if failed:
                     hit = 1
             kind_i = ti.cast(matp[pmat[i], 0], ti.i32)

@@ -59,8 +59,62 @@ def test_patch_uniform_stretch_gives_hooke(kind):
     assert np.abs(s[:, 1, 1] - want[1]).max() < 1e-6 * scale
     assert np.abs(s[:, 0, 1]).max() < 1e-6 * scale
     assert np.abs(p["stress_zz"][inside] - want[2]).max() < 1e-6 * scale
+    # the particle strain: the sum of the increments (carried to the particles in
+    # f32, so 1e-6 relative)
+    ex, ey = _strain_sum(lxx, dt, steps), _strain_sum(lyy, dt, steps)
+    e = p["strain"][inside]
+    assert np.abs(e[:, 0] - ex).max() < 1e-6 * abs(ex)
+    assert np.abs(e[:, 1] - ey).max() < 1e-6 * abs(ex)
+    assert np.abs(e[:, 2]).max() < 1e-6 * abs(ex)
     # particles in no element carry no stress
     assert np.all(p["stress"][~inside] == 0.0)
+
+
+@pytest.mark.parametrize("mode", ["shear", "tension"])
+def test_patch_mohr_coulomb_state_reaches_the_particles(mode):
+    """A uniform stretch beyond the strength of a Mohr–Coulomb body: the particles'
+    stress, plastic shear strain and failure mark are those of the correction applied
+    step by step to the same strain increments (stress to 1e-9, the plastic strain,
+    carried to the particles in f32, to 1e-6). Pure shear (εyy = −εxx) fails in
+    shear; isotropic tension of a body with a high cohesion fails at the tension
+    cut-off with no plastic shear strain, and is still marked failed."""
+    from test_materials import correct
+    lxx, lyy, coh, ten = (2.0, -2.0, 1e6, 2e7) if mode == "shear" else (2.0, 2.0, 1e8, 1e6)
+    mat = tdem.MohrCoulomb(RHO, E, NU, cohesion=coh, friction_angle=30.0,
+                           tensile_strength=ten)
+    pos, rad, tol = packing("regular")
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
+    v0 = pos * np.array([lxx, lyy])
+    g = sim.add_particles(pos, rad, material=mat, tolerance=tol, velocity=v0)
+    sim.fix_particles(g.ids, vx=v0[:, 0], vy=v0[:, 1])
+    steps = 40
+    sim.run(steps=steps)
+    dt = sim.dt
+    sig = np.zeros(4)
+    eps = 0.0
+    failed = False
+    for k in range(steps):
+        dx = lxx * dt / (1.0 + (k - 0.5) * dt * lxx)
+        dy = lyy * dt / (1.0 + (k - 0.5) * dt * lyy)
+        h = hooke(dx, dy)
+        out, e, f = correct([mat], sig + np.array([h[0], h[1], 0.0, h[2]]))
+        sig, eps, failed = out[0], eps + e[0], failed or f[0] > 0
+    p = sim.particles.numpy()
+    inside = p["elements"] > 0
+    assert inside.sum() > 0.8 * len(inside)
+    assert failed
+    assert np.all(p["failed"][inside])
+    scale = np.abs(sig).max()
+    s = p["stress"][inside]
+    assert np.abs(s[:, 0, 0] - sig[0]).max() < 1e-9 * scale
+    assert np.abs(s[:, 1, 1] - sig[1]).max() < 1e-9 * scale
+    assert np.abs(p["stress_zz"][inside] - sig[3]).max() < 1e-9 * scale
+    if mode == "shear":
+        assert eps > 1e-4
+        assert np.abs(p["plastic_strain"][inside] - eps).max() < 1e-6 * eps
+    else:
+        assert eps == 0.0
+        assert np.all(p["plastic_strain"][inside] == 0.0)
 
 
 def _rotate(points, c, ang):
