@@ -1059,16 +1059,16 @@ def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
         d = prb[i]
-        u = 0.0
+        u2 = 0.0
         pfail[i] = 1 if pstate[i][1] > 0.0 else 0
         if pmat[i] >= 0:
             ui = pu[i]
             for q in range(ncnt[i]):
                 j = nbr[i, q]
                 d = ti.max(d, prb[j])
-                u = ti.max(u, (pu[j] - ui).norm())
+                u2 = ti.max(u2, (pu[j] - ui).norm_sqr())
         pdirty[i] = d
-        unb[i] = u
+        unb[i] = ti.sqrt(u2)    # the largest distance (the square root is monotonic)
 
 
 @ti.kernel
