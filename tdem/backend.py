@@ -49,6 +49,37 @@ def init(arch=None, threads=None):
     return actual
 
 
-def serial_loops():
-    """True when parallel-for dispatch costs more than it gains (one CPU thread)."""
-    return _state["arch"] == "cpu" and _state["threads"] == 1
+# Below these sizes the kernels run their loops on one thread even when Taichi has
+# several: waking the pool costs about 65 us per parallel loop (a 2-core machine, a
+# dozen loops per step), more than a small model's loops take. Measured crossovers
+# on 2 threads (benchmarks/pack2d.py --rows, benchmarks/pcmm.py --side): a DEM pack
+# runs faster on one thread up to about 12,000 discs, a PCMM body up to about 2,000
+# particles (at 900, one thread is 1.2 times faster; at 8,100, two are 1.17 times).
+SERIAL_BELOW_DEM = 12000
+SERIAL_BELOW_ELEMENTS = 2000
+
+
+def serial_loops(n=None, elements=False):
+    """Whether kernels should run their loops on one thread: always with one CPU
+    thread, never on a GPU; on several CPU threads, for a model of fewer than
+    ``SERIAL_BELOW_ELEMENTS`` particles and block nodes when it has PCMM elements or
+    blocks (``elements``), else ``SERIAL_BELOW_DEM`` particles. ``$TDEM_SERIAL_BELOW``
+    sets the size for both (0: parallel loops whenever there are several threads).
+    The one-thread path sums contact forces in another order than the parallel one:
+    the two agree to round-off, and each gives the same result run after run."""
+    if _state["arch"] != "cpu":
+        return False
+    if _state["threads"] == 1:
+        return True
+    if n is None:
+        return False
+    below = SERIAL_BELOW_ELEMENTS if elements else SERIAL_BELOW_DEM
+    env = os.environ.get("TDEM_SERIAL_BELOW")
+    if env:
+        try:
+            below = int(env)
+        except ValueError:
+            below = -1
+        if below < 0:
+            raise InputError(f"TDEM_SERIAL_BELOW must be a whole number >= 0, got {env!r}")
+    return int(n) < below

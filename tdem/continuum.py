@@ -538,7 +538,7 @@ class Continuum:
     def before_forces(self, sim, dt, reach):
         """Candidates (after a list build), PCMM update and block update of one step."""
         a, e = self.a, sim._a
-        serial = backend.serial_loops()
+        serial = sim._serial()
         if self._fix_fn_nodes():
             self.apply_node_fixes(sim._time)
         if self.has_pcmm:
@@ -625,7 +625,7 @@ class Continuum:
                                 a["rstate"], a["rref"], sim._a["simp"])
             integrate_nodes(a["npos"], a["nvel"], a["nmass"], a["nforce"], a["nfix"],
                             a["nvfix"], a["nsize"], a["nreact"], sim._a["simp"], a["nflags"],
-                            backend.serial_loops())
+                            sim._serial())
 
     def status(self):
         """(candidate slots needed, first unstable node or −1)."""

@@ -367,6 +367,7 @@ class Simulation:
         self._walls_host = []      # rows of the wall table
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
+        self._was_serial = True    # the loop mode of the last step (see _serial)
         self._built = False
         self._a = {}
         self._snap = {}
@@ -1134,7 +1135,7 @@ class Simulation:
                 a["nbr"], a["ncnt"], a["hist"],
                 a["cn"], a["cf"], a["cs"], a["rev"], a["rcnt"], a["wall"], a["wforce"],
                 a["wid"], a["whist"], a["wcn"], a["wcf"], a["wcs"], a["lawp"], a["lawpair"],
-                a["flags"], a["simp"], self._xforce(), a["cskip"], backend.serial_loops())
+                a["flags"], a["simp"], self._xforce(), a["cskip"], self._serial())
 
     def _xforce(self):
         if self._cont is not None:
@@ -1145,6 +1146,20 @@ class Simulation:
         return x
 
 
+
+    def _serial(self):
+        """Whether this model's kernels run their loops on one thread
+        (:func:`tdem.backend.serial_loops`, by the number of particles and block nodes)."""
+        cont = self._cont
+        nodes = cont.nv if cont is not None else 0
+        elements = cont is not None and (cont.has_pcmm or nodes > 0)
+        serial = backend.serial_loops(self._n + nodes, elements)
+        if serial and self._n and not self._was_serial:
+            # the one-thread path adds into facc and clears it after use; the parallel
+            # path leaves its last sums there
+            self._a["facc"].from_numpy(np.zeros((self._n, 3)))
+        self._was_serial = serial
+        return serial
 
     def _engine_args(self):
         """Arguments of the step and rebuild kernels; the PCMM candidate search reach."""
@@ -1196,7 +1211,7 @@ class Simulation:
             if dst is None or tuple(dst.shape) != tuple(src.shape):
                 self._snap[k] = self._alloc_like(src)
         snapshot.copy_state(*[self._a[k] for k in snapshot.ORDER],
-                            *[self._snap[k] for k in snapshot.ORDER], backend.serial_loops())
+                            *[self._snap[k] for k in snapshot.ORDER], self._serial())
         self._snap_clock = (self._time, self._steps)
 
     def _alloc_like(self, src):
@@ -1209,7 +1224,7 @@ class Simulation:
             self._cont.restore_snapshot()
         if self._n:
             snapshot.copy_state(*[self._snap[k] for k in snapshot.ORDER],
-                                *[self._a[k] for k in snapshot.ORDER], backend.serial_loops())
+                                *[self._a[k] for k in snapshot.ORDER], self._serial())
         self._time, self._steps = self._snap_clock
         for m in self._monitors:
             m.truncate(self._steps)

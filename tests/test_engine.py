@@ -113,7 +113,8 @@ np.save(sys.argv[1], sim.particles.numpy()["position"])
 
 def test_one_thread_and_parallel_paths_agree(tmp_path):
     """On one thread partner forces are summed directly, in parallel they are gathered
-    from the slots: the two summation orders agree to round-off."""
+    from the slots: the two summation orders agree to round-off (TDEM_SERIAL_BELOW=0:
+    the 225 discs would otherwise run their loops on one thread on both)."""
     import os
     import subprocess
     import sys
@@ -123,7 +124,8 @@ def test_one_thread_and_parallel_paths_agree(tmp_path):
     out = {}
     for threads in ("1", "2"):
         subprocess.run([sys.executable, str(script), str(tmp_path / f"{threads}.npy")],
-                       env=dict(os.environ, TDEM_THREADS=threads), check=True,
+                       env=dict(os.environ, TDEM_THREADS=threads, TDEM_SERIAL_BELOW="0"),
+                       check=True,
                        capture_output=True)
         out[threads] = np.load(tmp_path / f"{threads}.npy")
     # a settling pile is chaotic: compare early enough that round-off has not grown
@@ -176,3 +178,48 @@ def test_prescribed_velocity_as_a_function_of_time():
                                                 rel=1e-12)
     assert p["position"][0, 1] == 0.0
     assert p["velocity"][0, 0] == pytest.approx(2.0 * (n - 1) * 1e-3, rel=1e-12)
+
+
+def test_size_rule_for_one_thread_loops(monkeypatch):
+    """Loops run on one thread with one CPU thread, never on a GPU, and on several
+    threads for models below the measured crossovers; TDEM_SERIAL_BELOW overrides
+    the size and a bad value is named."""
+    from tdem import backend
+    from tdem.errors import InputError
+    monkeypatch.setitem(backend._state, "arch", "cpu")
+    monkeypatch.setitem(backend._state, "threads", 2)
+    monkeypatch.delenv("TDEM_SERIAL_BELOW", raising=False)
+    dem, el = backend.SERIAL_BELOW_DEM, backend.SERIAL_BELOW_ELEMENTS
+    assert backend.serial_loops(dem - 1) and not backend.serial_loops(dem)
+    assert backend.serial_loops(el - 1, elements=True)
+    assert not backend.serial_loops(el, elements=True)
+    assert not backend.serial_loops()
+    monkeypatch.setenv("TDEM_SERIAL_BELOW", "0")
+    assert not backend.serial_loops(10)
+    monkeypatch.setenv("TDEM_SERIAL_BELOW", "500")
+    assert backend.serial_loops(499, elements=True) and not backend.serial_loops(500)
+    monkeypatch.setenv("TDEM_SERIAL_BELOW", "many")
+    with pytest.raises(InputError, match="TDEM_SERIAL_BELOW.*'many'"):
+        backend.serial_loops(10)
+    monkeypatch.setenv("TDEM_SERIAL_BELOW", "0")
+    monkeypatch.setitem(backend._state, "threads", 1)
+    assert backend.serial_loops(10 ** 6)
+    monkeypatch.setitem(backend._state, "arch", "gpu")
+    assert not backend.serial_loops(1)
+
+
+def test_switch_to_one_thread_loops_mid_run(monkeypatch):
+    """A run whose loops go from parallel to one thread between segments (here by
+    TDEM_SERIAL_BELOW) continues the parallel run to round-off: the one-thread path
+    does not pick up the parallel path's last force sums."""
+    runs = []
+    for switch in (False, True):
+        monkeypatch.setenv("TDEM_SERIAL_BELOW", "0")
+        sim = _box(8, 0.01, seed=3)
+        sim.run(steps=300)
+        if switch:
+            monkeypatch.setenv("TDEM_SERIAL_BELOW", "100000")
+        sim.run(steps=300)
+        assert sim._serial() == switch or tdem.backend._state["threads"] == 1
+        runs.append(sim.particles.numpy()["position"])
+    np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-9)
