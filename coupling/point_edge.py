@@ -61,6 +61,7 @@ import math
 import taichi as ti
 
 from physics.validate import in_range, non_negative, positive
+from tdem.launch import cached
 
 SLOTS = 4
 VERTEX_DEPTH = 0.05   # deepest vertex–edge penetration taken as a contact, × A
@@ -110,6 +111,7 @@ class PointEdge:
         return "PointEdge(" + ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items()) + ")"
 
 
+@cached
 @ti.kernel
 def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.ndarray(),
                npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
@@ -275,6 +277,7 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
         ti.atomic_add(xforce[p][1], ftot[1])
 
 
+@cached
 @ti.kernel
 def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64,
               hmin: ti.f64, gpar: ti.types.ndarray(), gcnt: ti.types.ndarray(),

@@ -27,11 +27,14 @@ Arrays (all blocks of a simulation concatenated; node indices are global):
 import numpy as np
 import taichi as ti
 
+from tdem.launch import cached
+
 from . import fvm
 from .materials import mc_correct_state
 from .pcmm import viscous_stress
 
 
+@cached
 @ti.kernel
 def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.ndarray(),
            tmat: ti.types.ndarray(), matp: ti.types.ndarray(), tsig: ti.types.ndarray(),

@@ -89,6 +89,7 @@ import taichi as ti
 
 from tdem import backend
 from tdem.errors import CapacityError, InputError
+from tdem.launch import cached
 
 from . import fvm
 from .materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
@@ -779,6 +780,7 @@ CARRIED = -1.0     # a pair history's overlap entry while elements carry the pai
 MAX_INCIDENT = 64  # slots of a particle's list of the elements containing it
 
 
+@cached
 @ti.kernel
 def candidates(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
                mtol: ti.types.ndarray(), cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
@@ -895,6 +897,7 @@ def _corner(o, e1, e2, i):
 SLACK_FLOOR = 1e-9   # relative to the radius: slack below this counts as none
 
 
+@cached
 @ti.kernel
 def displacements(pos: ti.types.ndarray(), pmat: ti.types.ndarray(),
                   xref: ti.types.ndarray(), pu: ti.types.ndarray(),
@@ -948,6 +951,7 @@ def _refresh_copies(a, ecnt: ti.template(), emult: ti.template(), ecopy: ti.temp
             esig[a, s] = _stress_of(a, s, esig, emult, ecopy)
 
 
+@cached
 @ti.kernel
 def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                      pmat: ti.types.ndarray(), mtol: ti.types.ndarray(),
@@ -1046,6 +1050,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
             ecnt[i] = 0
 
 
+@cached
 @ti.kernel
 def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
                pu: ti.types.ndarray(), prb: ti.types.ndarray(), pdirty: ti.types.ndarray(),
@@ -1071,6 +1076,7 @@ def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types
         unb[i] = ti.sqrt(u2)    # the largest distance (the square root is monotonic)
 
 
+@cached
 @ti.kernel
 def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
            emult: ti.types.ndarray(), ecopy: ti.types.ndarray(), pdirty: ti.types.ndarray(),
@@ -1125,6 +1131,7 @@ def sync_copies(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(), ecopy: ti.t
         _refresh_copies(a, ecnt, emult, ecopy, esig)
 
 
+@cached
 @ti.kernel
 def incidence(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
               elem: ti.types.ndarray(), ecnt: ti.types.ndarray(), emult: ti.types.ndarray(),
@@ -1239,6 +1246,7 @@ def _carried(a, b, c, s, elem: ti.template(), ecnt: ti.template(), esig: ti.temp
     return out, found
 
 
+@cached
 @ti.kernel
 def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.ndarray(),
              matp: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
@@ -1337,6 +1345,7 @@ def _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp: ti.templ
     _record(efor, a, s, fa, fb, fc, sig, de, eps, flag, emult[a, s])
 
 
+@cached
 @ti.kernel
 def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                       rad: ti.types.ndarray(), pos: ti.types.ndarray(),
@@ -1406,6 +1415,7 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                             emult[a, s])
 
 
+@cached
 @ti.kernel
 def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
            matp: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),

@@ -10,6 +10,7 @@ import os
 
 import taichi as ti
 
+from . import launch
 from .errors import InputError
 
 _state = {"arch": None, "threads": None}
@@ -43,6 +44,7 @@ def init(arch=None, threads=None):
     if _state["arch"] is not None:
         ti.reset()
     ti.init(**kwargs)
+    launch.reset()
     actual = "gpu" if ti.lang.impl.current_cfg().arch in (ti.cuda, ti.vulkan, ti.metal, ti.opengl) else "cpu"
     _state["arch"] = actual
     _state["threads"] = threads

@@ -28,6 +28,7 @@ from physics.materials import JWL, MAT_WIDTH, Fluid
 
 from . import backend
 from .errors import CapacityError, InputError
+from .launch import cached
 from .mesh import nodal_masses
 from .neighbors import F_BUILDS
 from .step import FIX_VX, FIX_VY, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY
@@ -41,6 +42,7 @@ _SNAP = ("psig", "peps", "pstate", "pjwl", "xforce", "cand", "ccnt", "pflags", "
          "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")
 
 
+@cached
 @ti.kernel
 def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                     nmass: ti.types.ndarray(), nforce: ti.types.ndarray(),
@@ -88,6 +90,7 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                 ti.atomic_min(nflags[0], v)
 
 
+@cached
 @ti.kernel
 def viscous_boundary(vel: ti.types.ndarray(), force: ti.types.ndarray(),
                      ids: ti.types.ndarray(), coef: ti.types.ndarray()):
@@ -104,6 +107,7 @@ def viscous_boundary(vel: ti.types.ndarray(), force: ti.types.ndarray(),
         ti.atomic_add(force[i][1], f[1])
 
 
+@cached
 @ti.kernel
 def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                     nforce: ti.types.ndarray(), nmass: ti.types.ndarray(),

@@ -28,6 +28,8 @@ simulation grows the arrays and redoes the steps since its last check.
 """
 import taichi as ti
 
+from .launch import cached
+
 # indices in the int status array ``flags``
 F_REBUILD = 0    # 1: lists must be rebuilt before the next force computation
 F_NEED = 1       # largest number of slots any particle needed (half or reverse list)
@@ -54,6 +56,7 @@ def cell_of(x, gridp: ti.template(), nx: ti.i32, ny: ti.i32):
     return ti.math.clamp(cx, 0, nx - 1), ti.math.clamp(cy, 0, ny - 1)
 
 
+@cached
 @ti.kernel
 def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.ndarray(),
             nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),

@@ -5,6 +5,8 @@ whatever the size of the system.
 """
 import taichi as ti
 
+from .launch import cached
+
 # order of the arrays passed to :func:`copy_state` (sources, then destinations)
 PER_PARTICLE = ("pos", "vel", "omega", "force", "torque", "xref", "eacc", "estate", "ncnt",
                 "rcnt")
@@ -14,6 +16,7 @@ OTHER = ("wall", "wforce", "flags")
 ORDER = PER_PARTICLE + PER_SLOT + PER_WALL_SLOT + OTHER
 
 
+@cached
 @ti.kernel
 def copy_state(a0: ti.types.ndarray(), a1: ti.types.ndarray(), a2: ti.types.ndarray(),
                a3: ti.types.ndarray(), a4: ti.types.ndarray(), a5: ti.types.ndarray(),

@@ -17,6 +17,7 @@ import taichi as ti
 from physics.contact_law import pair_force, elastic_energy
 from physics.rolling import rolling_couple
 
+from .launch import cached
 from .neighbors import F_BAD, F_REBUILD, slot_bits
 
 # columns of the float parameter array ``simp``
@@ -189,6 +190,7 @@ def servo_velocity(wall: ti.template(), wforce: ti.template(), w, dt):
     return v * d[0], v * d[1]
 
 
+@cached
 @ti.kernel
 def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
          prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
