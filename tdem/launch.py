@@ -17,10 +17,12 @@ its key comes round again) and is cleared when Taichi is re-initialised.
 The fast path is taken on the CPU only (the GPU path is Taichi's own call) and for
 kernels whose arguments are ndarrays, Python scalars and template values; anything
 else (numpy arrays, keyword arguments, a kernel that returns a value) goes through
-the plain call. ``TDEM_PLAIN_LAUNCH=1`` turns the fast path off everywhere.
+the plain call. ``TDEM_PLAIN_LAUNCH=1`` turns the fast path off everywhere (read
+when the module is imported and when Taichi is initialised).
 """
 import functools
 import numbers
+import operator
 import os
 import weakref
 
@@ -34,13 +36,28 @@ MAX_ENTRIES = 8            # argument sets remembered per kernel
 _generation = [0]          # bumped whenever Taichi is (re-)initialised
 
 
-def reset():
-    """Forget every cached launch (Taichi was re-initialised)."""
-    _generation[0] += 1
-
-
 def _enabled():
     return os.environ.get("TDEM_PLAIN_LAUNCH", "") in ("", "0")
+
+
+ENABLED = _enabled()       # read again by reset(); tests may set it
+
+
+def reset():
+    """Forget every cached launch (Taichi was re-initialised)."""
+    global ENABLED
+    _generation[0] += 1
+    ENABLED = _enabled()
+
+
+def _picker(indices):
+    """A function returning the tuple of the arguments at ``indices``."""
+    if not indices:
+        return lambda args: ()
+    if len(indices) == 1:
+        i = indices[0]
+        return lambda args: (args[i],)
+    return operator.itemgetter(*indices)
 
 
 class _Entry:
@@ -56,7 +73,8 @@ class Cached:
         self.kernel = kernel
         self._primal = kernel._primal
         self._entries = {}
-        self._gen = _generation[0]
+        self._gen = None
+        self._cpu = False
         kinds = []
         for arg in self._primal.arguments:
             ann = arg.annotation
@@ -71,31 +89,30 @@ class Cached:
             else:
                 kinds.append("?")
         self._kinds = tuple(kinds)
+        self._nargs = len(kinds)
+        self._arrays = _picker([i for i, k in enumerate(kinds) if k == "a"])
+        self._templates = _picker([i for i, k in enumerate(kinds) if k == "t"])
         self._plain = "?" in kinds or self._primal.return_type is not None
 
     def __call__(self, *args, **kwargs):
-        if (kwargs or self._plain or len(args) != len(self._kinds) or not _enabled()
-                or impl.current_cfg().arch not in (ti.x64, ti.arm64)):
+        if kwargs or self._plain or len(args) != self._nargs or not ENABLED:
             return self.kernel(*args, **kwargs)
         if self._gen != _generation[0]:
             self._entries.clear()
             self._gen = _generation[0]
-        key = []
-        for kind, v in zip(self._kinds, args):
-            if kind == "a":
-                if type(v) is not Ndarray and not isinstance(v, Ndarray):
-                    return self.kernel(*args)
-                key.append(id(v))
-            elif kind == "t":
-                if not isinstance(v, (bool, int, float, str)):
-                    return self.kernel(*args)
-                key.append((type(v), v))
-            else:
-                key.append(type(v))
-        key = tuple(key)
-        e = self._entries.get(key)
-        if e is not None and any(r() is None for r in e.refs):
-            del self._entries[key]     # an array of this entry is gone: its id may be reused
+            self._cpu = impl.current_cfg().arch in (ti.x64, ti.arm64)
+        if not self._cpu:
+            return self.kernel(*args)
+        # the arrays by identity (an entry's weak references say whether they are
+        # still the objects it was made for), the template values by type and value
+        try:
+            key = (tuple(map(id, self._arrays(args))),
+                   tuple((type(v), v) for v in self._templates(args)))
+            e = self._entries.get(key)
+        except TypeError:                 # an unhashable template value
+            return self.kernel(*args)
+        if e is not None and not all(r() is not None for r in e.refs):
+            del self._entries[key]        # an array of this entry is gone: its id may be reused
             e = None
         if e is None:
             # the plain call compiles the variant, checks the arguments and launches;
@@ -125,7 +142,7 @@ class Cached:
         if primal.has_print:
             return None
         for kind, v in zip(self._kinds, args):
-            if kind == "a" and v.grad is not None:
+            if kind == "a" and (not isinstance(v, Ndarray) or v.grad is not None):
                 return None
             if kind == "i" and not isinstance(v, numbers.Integral):
                 return None

@@ -6,6 +6,7 @@ import taichi as ti
 
 import tdem  # noqa: F401  (initialises Taichi through the engine's first simulation)
 from tdem import backend
+from tdem import launch
 from tdem.launch import cached
 
 
@@ -61,7 +62,7 @@ def test_cached_launches_follow_their_arguments():
 
 
 def _pcmm_run(monkeypatch, plain):
-    monkeypatch.setenv("TDEM_PLAIN_LAUNCH", "1" if plain else "0")
+    monkeypatch.setattr(launch, "ENABLED", not plain)
     pos, rad = tdem.pack.regular(0.2, 0.2, 0.01)
     soil = tdem.MohrCoulomb(density=2000.0, young=10e6, poisson=0.3, cohesion=1e3,
                             friction_angle=30.0, tensile_strength=500.0)
