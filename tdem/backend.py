@@ -13,7 +13,7 @@ import taichi as ti
 from . import launch
 from .errors import InputError
 
-_state = {"arch": None, "threads": None}
+_state = {"arch": None, "threads": None, "nthreads": None}
 
 
 def _arch_from(name):
@@ -48,6 +48,7 @@ def init(arch=None, threads=None):
     actual = "gpu" if ti.lang.impl.current_cfg().arch in (ti.cuda, ti.vulkan, ti.metal, ti.opengl) else "cpu"
     _state["arch"] = actual
     _state["threads"] = threads
+    _state["nthreads"] = int(ti.lang.impl.current_cfg().cpu_max_num_threads)
     return actual
 
 
@@ -61,21 +62,12 @@ SERIAL_BELOW_DEM = 12000
 SERIAL_BELOW_ELEMENTS = 2000
 
 
-def serial_loops(n=None, elements=False):
-    """Whether kernels should run their loops on one thread: always with one CPU
-    thread, never on a GPU; on several CPU threads, for a model of fewer than
-    ``SERIAL_BELOW_ELEMENTS`` particles and block nodes when it has PCMM elements or
-    blocks (``elements``), else ``SERIAL_BELOW_DEM`` particles. ``$TDEM_SERIAL_BELOW``
-    sets the size for both (0: parallel loops whenever there are several threads).
-    The one-thread path sums contact forces in another order than the parallel one:
-    the two agree to round-off, and each gives the same result run after run."""
-    if _state["arch"] != "cpu":
-        return False
-    if _state["threads"] == 1:
-        return True
-    if n is None:
-        return False
-    below = SERIAL_BELOW_ELEMENTS if elements else SERIAL_BELOW_DEM
+def serial_below(elements=False):
+    """The model size below which :func:`serial_loops` says yes, for the threads in
+    use. With T threads a loop of n items takes n·c/T + D instead of n·c (D: waking
+    the pool), so one thread is faster below n = D/(c·(1 − 1/T)): the sizes measured
+    on 2 threads times 0.5/(1 − 1/T) (0.53 on 16 threads). ``$TDEM_SERIAL_BELOW``
+    sets the size for every thread count and model (0: never)."""
     env = os.environ.get("TDEM_SERIAL_BELOW")
     if env:
         try:
@@ -84,4 +76,23 @@ def serial_loops(n=None, elements=False):
             below = -1
         if below < 0:
             raise InputError(f"TDEM_SERIAL_BELOW must be a whole number >= 0, got {env!r}")
-    return int(n) < below
+        return below
+    base = SERIAL_BELOW_ELEMENTS if elements else SERIAL_BELOW_DEM
+    t = max(int(_state["nthreads"] or 2), 2)
+    return int(round(base * 0.5 / (1.0 - 1.0 / t)))
+
+
+def serial_loops(n=None, elements=False):
+    """Whether kernels should run their loops on one thread: always with one CPU
+    thread, never on a GPU; on several CPU threads, for a model smaller than
+    :func:`serial_below` (n: its particles and block nodes; ``elements``: it has PCMM
+    elements or blocks). The one-thread path sums contact forces in another order
+    than the parallel one: the two agree to round-off, and each gives the same
+    result run after run."""
+    if _state["arch"] != "cpu":
+        return False
+    if _state["threads"] == 1 or _state["nthreads"] == 1:
+        return True
+    if n is None:
+        return False
+    return int(n) < serial_below(elements)

@@ -187,13 +187,19 @@ def test_size_rule_for_one_thread_loops(monkeypatch):
     from tdem import backend
     from tdem.errors import InputError
     monkeypatch.setitem(backend._state, "arch", "cpu")
-    monkeypatch.setitem(backend._state, "threads", 2)
+    monkeypatch.setitem(backend._state, "threads", None)
+    monkeypatch.setitem(backend._state, "nthreads", 2)
     monkeypatch.delenv("TDEM_SERIAL_BELOW", raising=False)
     dem, el = backend.SERIAL_BELOW_DEM, backend.SERIAL_BELOW_ELEMENTS
     assert backend.serial_loops(dem - 1) and not backend.serial_loops(dem)
     assert backend.serial_loops(el - 1, elements=True)
     assert not backend.serial_loops(el, elements=True)
     assert not backend.serial_loops()
+    # 16 threads gain more from a loop: one thread only below 0.5/(1 - 1/16) of it
+    monkeypatch.setitem(backend._state, "nthreads", 16)
+    assert backend.serial_below() == 6400 and backend.serial_below(True) == 1067
+    assert backend.serial_loops(6399) and not backend.serial_loops(6400)
+    monkeypatch.setitem(backend._state, "nthreads", 2)
     monkeypatch.setenv("TDEM_SERIAL_BELOW", "0")
     assert not backend.serial_loops(10)
     monkeypatch.setenv("TDEM_SERIAL_BELOW", "500")
@@ -202,7 +208,10 @@ def test_size_rule_for_one_thread_loops(monkeypatch):
     with pytest.raises(InputError, match="TDEM_SERIAL_BELOW.*'many'"):
         backend.serial_loops(10)
     monkeypatch.setenv("TDEM_SERIAL_BELOW", "0")
-    monkeypatch.setitem(backend._state, "threads", 1)
+    monkeypatch.setitem(backend._state, "nthreads", 1)      # a one-core machine
+    assert backend.serial_loops(10 ** 6)
+    monkeypatch.setitem(backend._state, "nthreads", 2)
+    monkeypatch.setitem(backend._state, "threads", 1)       # TDEM_THREADS=1
     assert backend.serial_loops(10 ** 6)
     monkeypatch.setitem(backend._state, "arch", "gpu")
     assert not backend.serial_loops(1)
