@@ -1190,24 +1190,48 @@ def _unpack2(v):
 
 
 @ti.func
-def _record(efor: ti.template(), a, s, fa, fb, fc, sig, de, eps, flag, mult):
-    """What the gather reads of a computed element: one 64-byte record per corner
-    (``efor[a, s, corner]``, so that a particle reads one cache line per element
-    containing it), each weighted by the multiplicity: the nodal force on the
-    corner (0–1), the stress (2–5), and, rounded to f32 and packed two to a slot
-    (:func:`_pack2`), the strain increment (6: xx, yy; 7: xy) and the plastic
-    shear strain increment (7, ≥ 0, marked for a failed element)."""
+def _record(efor: ti.template(), a, s, sig, sf, wf, de, eps, flag, mult):
+    """What the gather reads of a computed element: one 64-byte line per element
+    (``efor[a, s, 0]``), weighted by the multiplicity w: the stress (0–3); the weight
+    1/N_e of the nodal forces (4; 0 for an element whose forces another pass
+    writes); rounded to f32 and packed two to a slot (:func:`_pack2`), the strain
+    increment (5: xx, yy; 6: xy) and the plastic shear strain increment (6, ≥ 0,
+    marked for a failed element); 1 in slot 7 when the stress of the nodal forces
+    ``sf`` is not the stress (viscous stress, bulk viscosity), which then fills a
+    second line (``efor[a, s, 1]``, xx, yy, xy). The gather makes each corner's force
+    from these and the positions of the other two corners (:func:`_corner_force`)."""
     w = ti.cast(mult, ti.f64)
     ws = w * sig
     d01 = _pack2(w * de[0], w * de[1], 0)
     d2e = _pack2(w * de[2], ti.abs(w * eps), flag)
-    for k in ti.static(range(3)):
-        f = fa
-        if ti.static(k == 1):
-            f = fb
-        elif ti.static(k == 2):
-            f = fc
-        efor[a, s, k] = ti.Vector([w * f[0], w * f[1], ws[0], ws[1], ws[2], ws[3], d01, d2e])
+    two = 0.0
+    if sf[0] != sig[0] or sf[1] != sig[1] or sf[2] != sig[2]:
+        two = 1.0
+        efor[a, s, 1] = ti.Vector([w * sf[0], w * sf[1], w * sf[2], 0.0, 0.0, 0.0, 0.0, 0.0])
+    efor[a, s, 0] = ti.Vector([ws[0], ws[1], ws[2], ws[3], wf, d01, d2e, two])
+
+
+@ti.func
+def _corner_force(i, k, o, s, r, pos: ti.template(), elem: ti.template(),
+                  efor: ti.template()):
+    """The force of element (o, s) on its corner i (corner k of (o, b, c), counter-
+    clockwise) from its record line r (:func:`_record`): Eqs. 13–14, f = −½·(w/N_e)·
+    σ·m with m = n·ΔL of the edge opposite the corner (w in σ) (the sum of the normals of the
+    two edges meeting there), from the positions of the other two corners."""
+    b = elem[o, s, 0]
+    c = elem[o, s, 1]
+    p, q = b, c
+    if k == 1:
+        p, q = c, o
+    elif k == 2:
+        p, q = o, b
+    sxx, syy, sxy = r[0], r[1], r[2]
+    if r[7] != 0.0:
+        r2 = efor[o, s, 1]
+        sxx, syy, sxy = r2[0], r2[1], r2[2]
+    e = pos[p] - pos[q]
+    h = -0.5 * r[4]
+    return ti.Vector([h * (sxx * e[1] - sxy * e[0]), h * (sxy * e[1] - syy * e[0])])
 
 
 @ti.func
@@ -1265,8 +1289,8 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     own stress of last step if it existed and ``carry``, else the mean of its
     particles' stresses), Eqs. 6–11 with the Jaumann rotation (velocity gradient on
     the mid-step configuration, see :mod:`physics.blocks`), the constitutive
-    correction (Eq. 12), nodal forces with the weight 1/N_e (Eqs. 13–14, sign
-    fixed)."""
+    correction (Eq. 12), and the record from which the gather makes the nodal
+    forces with the weight 1/N_e (Eqs. 13–14, sign fixed; :func:`_record`)."""
     new = pflags[P_NEW] != 0
     ti.loop_config(serialize=serial)
     for a in range(pmat.shape[0]):
@@ -1286,7 +1310,6 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     if not new:
                         ti.atomic_add(pflags[P_RECOUNT], 1)
                     ebud[a, s] = sl - uw - SLACK_FLOOR * rad[a]
-                xa, xb, xc = pos[a], pos[b], pos[c]
                 grad, de, area = _kinematics(a, b, c, pos, vel, dt)
                 M = pmat[a]
                 kind = ti.cast(matp[M, 0], ti.i32)
@@ -1309,7 +1332,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                         failed = 1
                     sig, eps, flag = mc_correct_state(sig, matp, M, failed)
                 esig[a, s] = sig
-                _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp, emult,
+                _finish(a, s, M, sig, eps, flag, de, area, cover, matp, emult,
                         efor, ede, dt, eos)
 
 
@@ -1326,23 +1349,23 @@ def _kinematics(a, b, c, pos: ti.template(), vel: ti.template(), dt):
 
 
 @ti.func
-def _finish(a, s, M, sig, eps, flag, de, area, cover, xa, xb, xc, matp: ti.template(),
+def _finish(a, s, M, sig, eps, flag, de, area, cover, matp: ti.template(),
             emult: ti.template(), efor: ti.template(), ede: ti.template(), dt,
             eos: ti.template()):
     """The end of step 2 for element (a, s) with its corrected stress: the state
-    the equation of state reads (``ede``), the nodal forces (artificial bulk
-    viscosity and viscous stress included) and the gather's record (``efor``)."""
+    the equation of state reads (``ede``), the stress of its nodal forces
+    (artificial bulk viscosity and viscous stress included) and the gather's record
+    (``efor``), from which the gather makes the forces."""
     q = bulk_viscosity(matp, M, de, dt, area)
     if ti.static(eos):
         ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64),
                                area / cover, q * (de[0] + de[1])])
-    fa = ti.Vector([0.0, 0.0])
-    fb = ti.Vector([0.0, 0.0])
-    fc = ti.Vector([0.0, 0.0])
+    sf = sig
+    wf = 0.0
     if not _has_eos(matp, M):
         sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
-        fa, fb, fc = fvm.nodal_forces(sf, xa, xb, xc, 1.0 / cover)
-    _record(efor, a, s, fa, fb, fc, sig, de, eps, flag, emult[a, s])
+        wf = 1.0 / cover
+    _record(efor, a, s, sig, sf, wf, de, eps, flag, emult[a, s])
 
 
 @cached
@@ -1410,9 +1433,8 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                     if d[0] + d[1] < 0.0:
                         q = d[6] / (d[0] + d[1])
                     sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
-                    fa, fb, fc = fvm.nodal_forces(sf, pos[a], pos[b], pos[c], 1.0 / ncov[a, s])
-                    _record(efor, a, s, fa, fb, fc, sig, de, d[3], ti.cast(d[4], ti.i32),
-                            emult[a, s])
+                    _record(efor, a, s, sig, sf, 1.0 / ncov[a, s], de, d[3],
+                            ti.cast(d[4], ti.i32), emult[a, s])
 
 
 @cached
@@ -1426,7 +1448,9 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
            cskip: ti.types.ndarray(), hist: ti.types.ndarray(), prop: ti.types.ndarray(),
            pdirty: ti.types.ndarray(), pflags: ti.types.ndarray(), first: ti.i32,
            jwl: ti.template(), serial: ti.template()):
-    """3. Per particle (gathered, no atomics): force of its elements → xforce,
+    """3. Per particle (gathered, no atomics): force of its elements → xforce (each
+    made from the element's record and the positions of its other two corners,
+    :func:`_corner_force`),
     stress = mean of its elements' σ (zero in none), strain and plastic shear
     strain += the means of the increments; the engine's pair slots (``cskip``,
     rewritten where the elements around the particle changed, at the start of an
@@ -1454,11 +1478,13 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
             cnt = ti.cast(iwt[i], ti.f64)
             for q in range(icnt[i]):
                 code = inc[i, q]
-                r = efor[code >> 6, (code >> 2) & 15, code & 3]
-                f += ti.Vector([r[0], r[1]])
-                ssum += ti.Vector([r[2], r[3], r[4], r[5]])
-                dxx, dyy, _ = _unpack2(r[6])
-                dxy, ep, failed = _unpack2(r[7])
+                o = code >> 6
+                s = (code >> 2) & 15
+                r = efor[o, s, 0]
+                f += _corner_force(i, code & 3, o, s, r, pos, elem, efor)
+                ssum += ti.Vector([r[0], r[1], r[2], r[3]])
+                dxx, dyy, _ = _unpack2(r[5])
+                dxy, ep, failed = _unpack2(r[6])
                 dsum += ti.Vector([dxx, dyy, dxy])
                 psum += ti.abs(ep)
                 if failed:

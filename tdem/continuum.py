@@ -208,7 +208,7 @@ class Continuum:
         a["earea"] = ti.ndarray(ti.f64, (n, E))
         a["ncov"] = ti.ndarray(ti.i32, (n, E))
         a["esig"] = _arr(4, (n, E))
-        a["efor"] = _arr(8, (n, E, 3))
+        a["efor"] = _arr(8, (n, E, 2))
         a["ede"] = _arr(7, (n, E))
         a["psig"] = _arr(4, (n,))
         a["peps"] = _arr(3, (n,))
