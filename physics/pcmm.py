@@ -1212,12 +1212,12 @@ def _record(efor: ti.template(), a, s, sig, sf, wf, de, eps, flag, mult):
 
 
 @ti.func
-def _corner_force(i, k, o, s, r, pos: ti.template(), elem: ti.template(),
-                  efor: ti.template()):
-    """The force of element (o, s) on its corner i (corner k of (o, b, c), counter-
-    clockwise) from its record line r (:func:`_record`): Eqs. 13–14, f = −½·(w/N_e)·
-    σ·m with m = n·ΔL of the edge opposite the corner (w in σ) (the sum of the normals of the
-    two edges meeting there), from the positions of the other two corners."""
+def _corner_force(k, o, s, r, pos: ti.template(), elem: ti.template(), efor: ti.template()):
+    """The force of element (o, s) on its corner k (of (o, b, c), counter-
+    clockwise) from its record line r (:func:`_record`), Eqs. 13–14: f = −½·σ·m/N_e,
+    σ the stress of the forces (times the multiplicity), m = n·ΔL of the edge
+    opposite the corner (the sum of those of the two edges meeting there), from the
+    positions of the other two corners."""
     b = elem[o, s, 0]
     c = elem[o, s, 1]
     p, q = b, c
@@ -1481,7 +1481,7 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 o = code >> 6
                 s = (code >> 2) & 15
                 r = efor[o, s, 0]
-                f += _corner_force(i, code & 3, o, s, r, pos, elem, efor)
+                f += _corner_force(code & 3, o, s, r, pos, elem, efor)
                 ssum += ti.Vector([r[0], r[1], r[2], r[3]])
                 dxx, dyy, _ = _unpack2(r[5])
                 dxy, ep, failed = _unpack2(r[6])
