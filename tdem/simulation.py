@@ -367,7 +367,6 @@ class Simulation:
         self._walls_host = []      # rows of the wall table
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
-        self._was_serial = True    # the loop mode of the last step (see _serial)
         self._built = False
         self._a = {}
         self._snap = {}
@@ -1153,13 +1152,7 @@ class Simulation:
         cont = self._cont
         nodes = cont.nv if cont is not None else 0
         elements = cont is not None and (cont.has_pcmm or nodes > 0)
-        serial = backend.serial_loops(self._n + nodes, elements)
-        if serial and self._n and not self._was_serial:
-            # the one-thread path adds into facc and clears it after use; the parallel
-            # path leaves its last sums there
-            self._a["facc"].from_numpy(np.zeros((self._n, 3)))
-        self._was_serial = serial
-        return serial
+        return backend.serial_loops(self._n + nodes, elements)
 
     def _engine_args(self):
         """Arguments of the step and rebuild kernels; the PCMM candidate search reach."""

@@ -290,9 +290,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         a = facc[i]
         f = ti.Vector([a[0], a[1]])
         tq = a[2]
-        if ti.static(serial):
-            facc[i] = ti.Vector([0.0, 0.0, 0.0])
-        else:
+        # the sums start from zero at every step on either path (the one-thread path
+        # adds into them), whichever path the next step takes
+        facc[i] = ti.Vector([0.0, 0.0, 0.0])
+        if ti.static(not serial):
             for r in range(rcnt[i]):
                 flat = rev[i, r]
                 j = flat >> bits
