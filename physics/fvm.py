@@ -178,6 +178,16 @@ def nodal_forces(sig, xa, xb, xc, weight):
     return fa, fb, fc
 
 
+@ti.func
+def corner_force(sig, xu, xv, weight):
+    """Eqs. 13–14 for one node: the force of the element on the corner whose
+    opposite edge runs u → v (u, v the next two corners, counter-clockwise),
+    f = weight·½·σ·m_opp with m_opp = n·ΔL of that edge (the sum of those of the two
+    edges meeting at the corner). The three corners' forces are those of
+    :func:`nodal_forces`."""
+    return 0.5 * weight * stress_dot(sig, edge_normal(xu, xv))
+
+
 # ------------------------------------------------------------------ kernels
 @ti.kernel
 def update_triangles(pos: ti.types.ndarray(dtype=V2, ndim=1),

@@ -1213,25 +1213,22 @@ def _record(efor: ti.template(), a, s, sig, sf, wf, de, eps, flag, mult):
 
 @ti.func
 def _corner_force(k, o, s, r, pos: ti.template(), elem: ti.template(), efor: ti.template()):
-    """The force of element (o, s) on its corner k (of (o, b, c), counter-
-    clockwise) from its record line r (:func:`_record`), Eqs. 13–14: f = −½·σ·m/N_e,
-    σ the stress of the forces (times the multiplicity), m = n·ΔL of the edge
-    opposite the corner (the sum of those of the two edges meeting there), from the
+    """The force of element (o, s) on its corner k (of (o, b, c), counter-clockwise)
+    from its record line r (:func:`_record`): :func:`physics.fvm.corner_force` with
+    the stress of the forces (times the multiplicity), the weight 1/N_e and the
     positions of the other two corners."""
     b = elem[o, s, 0]
     c = elem[o, s, 1]
-    p, q = b, c
+    u, v = b, c
     if k == 1:
-        p, q = c, o
+        u, v = c, o
     elif k == 2:
-        p, q = o, b
-    sxx, syy, sxy = r[0], r[1], r[2]
+        u, v = o, b
+    sf = ti.Vector([r[0], r[1], r[2], 0.0])
     if r[7] != 0.0:
         r2 = efor[o, s, 1]
-        sxx, syy, sxy = r2[0], r2[1], r2[2]
-    e = pos[p] - pos[q]
-    h = -0.5 * r[4]
-    return ti.Vector([h * (sxx * e[1] - sxy * e[0]), h * (sxy * e[1] - syy * e[0])])
+        sf = ti.Vector([r2[0], r2[1], r2[2], 0.0])
+    return fvm.corner_force(sf, pos[u], pos[v], r[4])
 
 
 @ti.func

@@ -191,6 +191,46 @@ def test_triangle_forces_balance_and_pull_inward():
     np.testing.assert_allclose(f1, [[0.25, 0.0], [-0.25, 0.0], [0.0, 0.0]], atol=1e-15)
 
 
+def test_corner_force_is_the_nodal_force_of_its_corner():
+    """One corner's force from the edge opposite it (what the PCMM gather uses) equals
+    that corner's force of nodal_forces, for random counter-clockwise triangles."""
+    import taichi as ti
+    backend.init()
+    rng = np.random.default_rng(7)
+    nt = 100
+    p = rng.uniform(-1, 1, (nt, 3, 2))
+    u = p[:, 1] - p[:, 0]
+    v = p[:, 2] - p[:, 0]
+    cw = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0] < 0
+    p[cw] = p[cw][:, ::-1]
+    sig = rng.normal(0, 1e6, (nt, 4))
+    w = rng.uniform(0.1, 1.0, nt)
+    out = np.zeros((nt, 2, 3, 2))
+
+    @ti.kernel
+    def both(p: ti.types.ndarray(), sig: ti.types.ndarray(), w: ti.types.ndarray(),
+             out: ti.types.ndarray()):
+        for t in range(p.shape[0]):
+            x = [ti.Vector([p[t, k, 0], p[t, k, 1]]) for k in ti.static(range(3))]
+            s = ti.Vector([sig[t, 0], sig[t, 1], sig[t, 2], sig[t, 3]])
+            fa, fb, fc = fvm.nodal_forces(s, x[0], x[1], x[2], w[t])
+            for k in ti.static(range(3)):
+                f = fa
+                if ti.static(k == 1):
+                    f = fb
+                elif ti.static(k == 2):
+                    f = fc
+                g = fvm.corner_force(s, x[(k + 1) % 3], x[(k + 2) % 3], w[t])
+                for d in ti.static(range(2)):
+                    out[t, 0, k, d] = f[d]
+                    out[t, 1, k, d] = g[d]
+
+    both(p, sig, w, out)
+    scale = np.abs(out[:, 0]).max()
+    assert scale > 1e4
+    np.testing.assert_allclose(out[:, 1], out[:, 0], rtol=0, atol=1e-14 * scale)
+
+
 @pytest.mark.parametrize("pattern", ["regular", "cross"])
 def test_uniform_stress_gives_boundary_tractions(pattern):
     w, h = 1.0, 0.8
