@@ -162,14 +162,20 @@ def test_rigid_rotation(S):
 
 
 # ------------------------------------------------------------------ nodal forces
-def test_triangle_forces_balance_and_pull_inward():
-    rng = np.random.default_rng(4)
-    nt = 200
+def _ccw_triangles(rng, nt):
+    """nt random counter-clockwise triangles in [-1, 1]², as (nt, 3, 2) corners."""
     p = rng.uniform(-1, 1, (nt, 3, 2))
     u = p[:, 1] - p[:, 0]
     v = p[:, 2] - p[:, 0]
     cw = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0] < 0
     p[cw] = p[cw][:, ::-1]
+    return p
+
+
+def test_triangle_forces_balance_and_pull_inward():
+    rng = np.random.default_rng(4)
+    nt = 200
+    p = _ccw_triangles(rng, nt)
     pos = np.ascontiguousarray(p.reshape(-1, 2))
     tri = np.arange(3 * nt, dtype=np.int32).reshape(nt, 3)
     sig = rng.normal(0, 1e6, (nt, 4))
@@ -198,11 +204,7 @@ def test_corner_force_is_the_nodal_force_of_its_corner():
     backend.init()
     rng = np.random.default_rng(7)
     nt = 100
-    p = rng.uniform(-1, 1, (nt, 3, 2))
-    u = p[:, 1] - p[:, 0]
-    v = p[:, 2] - p[:, 0]
-    cw = u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0] < 0
-    p[cw] = p[cw][:, ::-1]
+    p = _ccw_triangles(rng, nt)
     sig = rng.normal(0, 1e6, (nt, 4))
     w = rng.uniform(0.1, 1.0, nt)
     out = np.zeros((nt, 2, 3, 2))
