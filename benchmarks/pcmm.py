@@ -77,6 +77,35 @@ def measure(side, steps, warmup, arch, threads, rounds=5, dem=True):
     return info, rates, dem_rates, (pack.n_particles if pack is not None else 0)
 
 
+def machine():
+    """One line naming the CPU, its count and cache sizes (Linux; what is not found is
+    left out): the rates and their ratio differ much between machines."""
+    import glob
+    import platform
+    name = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            names = [ln.split(":", 1)[1].strip() for ln in f if ln.startswith("model name")]
+        name = names[0] if names else name
+    except OSError:
+        pass
+    caches = {}
+    for d in sorted(glob.glob("/sys/devices/system/cpu/cpu0/cache/index*")):
+        try:
+            with open(os.path.join(d, "level")) as f:
+                level = f.read().strip()
+            with open(os.path.join(d, "type")) as f:
+                kind = f.read().strip()
+            with open(os.path.join(d, "size")) as f:
+                size = f.read().strip()
+        except OSError:
+            continue
+        if kind != "Instruction":
+            caches[f"L{level}"] = size
+    parts = [name, f"{os.cpu_count()} CPUs"] + [f"{k} {v}" for k, v in sorted(caches.items())]
+    return ", ".join(parts)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -94,6 +123,7 @@ def main(argv=None):
     r, rates, dem_rates, n_dem = measure(args.side, args.steps, args.warmup, args.arch,
                                          args.threads, args.rounds, not args.no_dem)
     rate = float(np.median(rates))
+    print(f"machine: {machine()}")
     print(f"PCMM particles {r['particles']} steps {r['steps']} in {args.rounds} rounds "
           f"(t = {r['time']:.4g} s, dt = {r['dt']:.3g} s, {r['elements']} elements, "
           f"{100 * r['failed_fraction']:.0f} % failed, spread {r['spread']:.3f} m)")
