@@ -18,17 +18,19 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
+from benchmarks.pcmm import PACKINGS  # noqa: E402
+
 KERNELS = ("stresses", "gather")
 
 
-def measure(side, warmup, calls, arch, threads):
+def measure(side, warmup, calls, arch, threads, packing="regular"):
     """{kernel name: array of ms per call} after ``warmup`` steps of the column."""
     import taichi as ti
 
     import tdem  # noqa: F401  (tdem first: it imports physics in its order)
     from benchmarks.pcmm import build
     from physics import pcmm
-    sim = build(side, arch, threads)
+    sim = build(side, arch, threads, packing)
     sim.run(steps=max(warmup - 1, 0))
     args, orig = {}, {name: getattr(pcmm, name) for name in KERNELS}
 
@@ -61,6 +63,7 @@ def main(argv=None):
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--threads", type=int, default=2)
     p.add_argument("--side", type=int, default=200, help="particles per row (side²)")
+    p.add_argument("--packing", choices=PACKINGS, default="regular")
     p.add_argument("--warmup", type=int, default=1500)
     p.add_argument("--calls", type=int, default=80, help="timed calls of each kernel")
     p.add_argument("--arch", default=None)
@@ -69,7 +72,7 @@ def main(argv=None):
         p.error(f"--calls must be >= 1, got {args.calls}")
     if args.warmup < 1:
         p.error(f"--warmup must be >= 1, got {args.warmup}")
-    times = measure(args.side, args.warmup, args.calls, args.arch, args.threads)
+    times = measure(args.side, args.warmup, args.calls, args.arch, args.threads, args.packing)
     for name, t in times.items():
         print(f"{name}: fastest {t.min():.2f} ms, first quartile {np.percentile(t, 25):.2f} ms, "
               f"median {np.median(t):.2f} ms ({len(t)} calls, {args.threads} threads)")

@@ -1133,6 +1133,31 @@ def sync_copies(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(), ecopy: ti.t
 
 @cached
 @ti.kernel
+def record_slots(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(),
+                 ebase: ti.types.ndarray(), serial: ti.template()):
+    """1d. Where the records of the computed elements go (:func:`_record`): one run
+    per particle, in particle order, the run of particle a from ``ebase[a]`` on, in
+    slot order (the stress pass writes each slot's place to ``eidx``). The gather
+    reads the records of the elements around a particle; packed so, they lie close
+    together in memory for neighbouring particles, instead of one fixed-capacity
+    block per particle with the used slots scattered in it."""
+    n = ecnt.shape[0]
+    ti.loop_config(serialize=serial)
+    for a in range(n):
+        k = 0
+        for s in range(ecnt[a]):
+            if emult[a, s] > 0:
+                k += 1
+        ebase[a + 1] = k
+    ebase[0] = 0
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        for a in range(n):
+            ebase[a + 1] += ebase[a]
+
+
+@cached
+@ti.kernel
 def incidence(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
               elem: ti.types.ndarray(), ecnt: ti.types.ndarray(), emult: ti.types.ndarray(),
               inc: ti.types.ndarray(), icnt: ti.types.ndarray(), iwt: ti.types.ndarray(),
@@ -1190,15 +1215,16 @@ def _unpack2(v):
 
 
 @ti.func
-def _record(efor: ti.template(), a, s, sig, sf, wf, de, eps, flag, mult):
+def _record(efor: ti.template(), j, sig, sf, wf, de, eps, flag, mult):
     """What the gather reads of a computed element: one 64-byte line per element
-    (``efor[a, s, 0]``), weighted by the multiplicity w: the stress (0–3); the weight
+    (``efor[j, 0]``, j = ``eidx[a, s]``, see :func:`record_slots`), weighted by the
+    multiplicity w: the stress (0–3); the weight
     1/N_e of the nodal forces (4; 0 for an element whose forces another pass
     writes); rounded to f32 and packed two to a slot (:func:`_pack2`), the strain
     increment (5: xx, yy; 6: xy) and the plastic shear strain increment (6, ≥ 0,
     marked for a failed element); 1 in slot 7 when the stress of the nodal forces
     ``sf`` is not the stress (viscous stress, bulk viscosity), which then fills a
-    second line (``efor[a, s, 1]``, xx, yy, xy). The gather makes each corner's force
+    second line (``efor[j, 1]``, xx, yy, xy). The gather makes each corner's force
     from these and the positions of the other two corners (:func:`_corner_force`)."""
     w = ti.cast(mult, ti.f64)
     ws = w * sig
@@ -1207,14 +1233,16 @@ def _record(efor: ti.template(), a, s, sig, sf, wf, de, eps, flag, mult):
     two = 0.0
     if sf[0] != sig[0] or sf[1] != sig[1] or sf[2] != sig[2]:
         two = 1.0
-        efor[a, s, 1] = ti.Vector([w * sf[0], w * sf[1], w * sf[2], 0.0, 0.0, 0.0, 0.0, 0.0])
-    efor[a, s, 0] = ti.Vector([ws[0], ws[1], ws[2], ws[3], wf, d01, d2e, two])
+        efor[j, 1] = ti.Vector([w * sf[0], w * sf[1], w * sf[2], 0.0, 0.0, 0.0, 0.0, 0.0])
+    efor[j, 0] = ti.Vector([ws[0], ws[1], ws[2], ws[3], wf, d01, d2e, two])
 
 
 @ti.func
-def _corner_force(k, o, s, r, pos: ti.template(), elem: ti.template(), efor: ti.template()):
+def _corner_force(k, o, s, j, r, pos: ti.template(), elem: ti.template(),
+                  efor: ti.template()):
     """The force of element (o, s) on its corner k (of (o, b, c), counter-clockwise)
-    from its record line r (:func:`_record`): :func:`physics.fvm.corner_force` with
+    from its record line r = ``efor[j, 0]`` (:func:`_record`):
+    :func:`physics.fvm.corner_force` with
     the stress of the forces (times the multiplicity), the weight 1/N_e and the
     positions of the other two corners."""
     b = elem[o, s, 0]
@@ -1226,7 +1254,7 @@ def _corner_force(k, o, s, r, pos: ti.template(), elem: ti.template(), efor: ti.
         u, v = o, b
     sf = ti.Vector([r[0], r[1], r[2], 0.0])
     if r[7] != 0.0:
-        r2 = efor[o, s, 1]
+        r2 = efor[j, 1]
         sf = ti.Vector([r2[0], r2[1], r2[2], 0.0])
     return fvm.corner_force(sf, pos[u], pos[v], r[4])
 
@@ -1278,8 +1306,8 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
              elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
              ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(), prb: ti.types.ndarray(),
              pdirty: ti.types.ndarray(), unb: ti.types.ndarray(), pu: ti.types.ndarray(),
-             pflags: ti.types.ndarray(), dt: ti.f64, carry: ti.template(),
-             eos: ti.template(), serial: ti.template()):
+             pflags: ti.types.ndarray(), ebase: ti.types.ndarray(), eidx: ti.types.ndarray(),
+             dt: ti.f64, carry: ti.template(), eos: ti.template(), serial: ti.template()):
     """2. Per computed element: N_e (probe rule; recounted where the elements around
     it changed or its vertices' neighbourhoods moved farther than the count's slack,
     ``ebud``, the same bookkeeping as :func:`rebuild_elements`), σ_old (the element's
@@ -1287,12 +1315,15 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     particles' stresses), Eqs. 6–11 with the Jaumann rotation (velocity gradient on
     the mid-step configuration, see :mod:`physics.blocks`), the constitutive
     correction (Eq. 12), and the record from which the gather makes the nodal
-    forces with the weight 1/N_e (Eqs. 13–14, sign fixed; :func:`_record`)."""
+    forces with the weight 1/N_e (Eqs. 13–14, sign fixed; :func:`_record`), in the
+    next place of the particle's run of records (``eidx``, :func:`record_slots`)."""
     new = pflags[P_NEW] != 0
     ti.loop_config(serialize=serial)
     for a in range(pmat.shape[0]):
+        j = ebase[a]
         for s in range(ecnt[a]):
             if emult[a, s] > 0:
+                eidx[a, s] = j
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
                 v0, v1, v2 = _sorted3(a, b, c)
@@ -1329,8 +1360,9 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                         failed = 1
                     sig, eps, flag = mc_correct_state(sig, matp, M, failed)
                 esig[a, s] = sig
-                _finish(a, s, M, sig, eps, flag, de, area, cover, matp, emult,
+                _finish(a, s, j, M, sig, eps, flag, de, area, cover, matp, emult,
                         efor, ede, dt, eos)
+                j += 1
 
 
 @ti.func
@@ -1346,7 +1378,7 @@ def _kinematics(a, b, c, pos: ti.template(), vel: ti.template(), dt):
 
 
 @ti.func
-def _finish(a, s, M, sig, eps, flag, de, area, cover, matp: ti.template(),
+def _finish(a, s, j, M, sig, eps, flag, de, area, cover, matp: ti.template(),
             emult: ti.template(), efor: ti.template(), ede: ti.template(), dt,
             eos: ti.template()):
     """The end of step 2 for element (a, s) with its corrected stress: the state
@@ -1362,7 +1394,7 @@ def _finish(a, s, M, sig, eps, flag, de, area, cover, matp: ti.template(),
     if not _has_eos(matp, M):
         sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
         wf = 1.0 / cover
-    _record(efor, a, s, sig, sf, wf, de, eps, flag, emult[a, s])
+    _record(efor, j, sig, sf, wf, de, eps, flag, emult[a, s])
 
 
 @cached
@@ -1373,6 +1405,7 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                       emult: ti.types.ndarray(), inc: ti.types.ndarray(),
                       icnt: ti.types.ndarray(), ncov: ti.types.ndarray(),
                       esig: ti.types.ndarray(), efor: ti.types.ndarray(),
+                      eidx: ti.types.ndarray(),
                       ede: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
                       time: ti.f64, serial: ti.template()):
     """2j. Particles with an equation of state (JWL, or a Fluid with
@@ -1430,7 +1463,7 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                     if d[0] + d[1] < 0.0:
                         q = d[6] / (d[0] + d[1])
                     sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
-                    _record(efor, a, s, sig, sf, 1.0 / ncov[a, s], de, d[3],
+                    _record(efor, eidx[a, s], sig, sf, 1.0 / ncov[a, s], de, d[3],
                             ti.cast(d[4], ti.i32), emult[a, s])
 
 
@@ -1439,7 +1472,8 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
 def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
            matp: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
            elem: ti.types.ndarray(), inc: ti.types.ndarray(), icnt: ti.types.ndarray(),
-           iwt: ti.types.ndarray(), efor: ti.types.ndarray(), psig: ti.types.ndarray(),
+           iwt: ti.types.ndarray(), efor: ti.types.ndarray(), eidx: ti.types.ndarray(),
+           psig: ti.types.ndarray(),
            peps: ti.types.ndarray(), pstate: ti.types.ndarray(), xforce: ti.types.ndarray(),
            pjwl: ti.types.ndarray(), enbr: ti.types.ndarray(), encnt: ti.types.ndarray(),
            cskip: ti.types.ndarray(), hist: ti.types.ndarray(), prop: ti.types.ndarray(),
@@ -1477,8 +1511,9 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 code = inc[i, q]
                 o = code >> 6
                 s = (code >> 2) & 15
-                r = efor[o, s, 0]
-                f += _corner_force(code & 3, o, s, r, pos, elem, efor)
+                j = eidx[o, s]
+                r = efor[j, 0]
+                f += _corner_force(code & 3, o, s, j, r, pos, elem, efor)
                 ssum += ti.Vector([r[0], r[1], r[2], r[3]])
                 dxx, dyy, _ = _unpack2(r[5])
                 dxy, ep, failed = _unpack2(r[6])
@@ -1579,17 +1614,19 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
            a["esig"], serial)
     incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
               a["picnt"], a["piwt"], a["pdirty"], a["pflags"], serial)
+    record_slots(a["ecnt"], a["emult"], a["ebase"], serial)
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
              a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["efor"], a["ede"],
              a["psig"], a["pfail"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
-             a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], dt, carry, eos,
-             serial)
+             a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], a["ebase"],
+             a["eidx"], dt, carry, eos, serial)
     if eos:
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],
-                          a["efor"], a["ede"], a["pjwl"], dt, time, serial)
+                          a["efor"], a["eidx"], a["ede"], a["pjwl"], dt, time, serial)
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
-           a["pinc"], a["picnt"], a["piwt"], a["efor"], a["psig"], a["peps"], a["pstate"],
+           a["pinc"], a["picnt"], a["piwt"], a["efor"], a["eidx"], a["psig"], a["peps"],
+           a["pstate"],
            a["xforce"], a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], e["hist"], e["prop"],
            a["pdirty"], a["pflags"], int(first), eos, serial)
 

@@ -243,6 +243,8 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     discs by these pushes plus 0.85 × their previous motion (heavy-ball momentum,
     reset whenever the motion opposes the pushes).
 
+    The discs are listed as the lattices list theirs: in rows one mean diameter
+    high, from the bottom up, x increasing along a row (see :func:`_in_rows`).
     Deterministic for a given ``seed``. ``target_fraction`` must lie in (0, 0.85];
     random packings jam near 0.82–0.84 (R = 0.168–0.312 m in a 20 × 20 m square
     jam at about 0.825, walls included), and a fraction that cannot be reached
@@ -348,7 +350,7 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
                 worst = max(worst, float(pen[out].max()))
                 push[near_edge[out]] += pen[out][:, None] * inward[out]
         if scale == 1.0 and worst <= tol:
-            return x, r
+            return _in_rows(x, r, nb)
         # heavy-ball relaxation, restarted when the motion turns against the push
         if np.sum(push * vel) < 0.0:
             vel[:] = 0.0
@@ -358,6 +360,20 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     raise InputError(f"target_fraction={target_fraction!r} could not be reached without "
                      f"overlaps in {max_iter} sweeps (largest overlap {worst:.3g} m); "
                      f"lower it")
+
+
+def _in_rows(x, r, nb):
+    """x and r with the discs after the first ``nb`` reordered into rows one mean
+    diameter high, bottom to top, x increasing along each row. Discs close in space
+    are then close in the arrays, as in the lattices: the kernels go over each
+    particle's neighbours, and how well the memory caches serve them depends on it
+    (in random order a PCMM step takes about 1.6 times as long)."""
+    if len(r) - nb < 2:
+        return x, r
+    y = x[nb:, 1]
+    row = np.floor((y - y.min()) / (2.0 * r[nb:].mean()))
+    keep = np.concatenate([np.arange(nb), nb + np.lexsort((x[nb:, 0], row))])
+    return x[keep], r[keep]
 
 
 def _edge_discs(poly, rmin, rmax, rng):

@@ -87,6 +87,22 @@ def test_random_is_deterministic_for_a_seed():
     assert len(a[1]) != len(c[1]) or not np.array_equal(a[0], c[0])
 
 
+def test_random_lists_discs_in_rows():
+    """Rows one mean diameter high, bottom to top, x increasing along a row; so
+    touching discs lie close in the arrays: the median index distance of touching
+    pairs is below the discs of one row (about 2·20/(2·0.24) = 83 here), where the
+    order of the relaxation would put it near N/3 = 570."""
+    x, r = pack.random(20.0, 20.0, 0.168, 0.312, seed=0)
+    row = np.floor((x[:, 1] - x[:, 1].min()) / (2.0 * r.mean()))
+    assert np.all(np.diff(row) >= 0)
+    same = np.diff(row) == 0
+    assert np.all(np.diff(x[:, 0])[same] > 0)
+    d = np.linalg.norm(x[:, None] - x[None], axis=2) - r[:, None] - r[None]
+    i, j = np.nonzero(np.triu(d < 1e-3 * 0.168, 1))
+    assert len(i) > len(x)
+    assert np.median(j - i) < 83
+
+
 def test_random_in_a_polygon():
     """An L-shaped region (area 6 m², a re-entrant corner), given clockwise."""
     poly = np.array([[0, 0], [0, 3], [1, 3], [1, 1], [4, 1], [4, 0]], dtype=float)

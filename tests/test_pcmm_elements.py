@@ -207,14 +207,17 @@ def _reference_elements(x, r, tol):
 
 
 def _reference_cover(x, triangles, sample):
-    """N_e by brute force: every element tested against the probe of e."""
+    """N_e by brute force: every element sharing a particle with e (the spec's rule,
+    PHYSICS.md §3: in an unfolded element system only these can cover e's probe;
+    the deformed packing below folds elements over others that share no particle
+    with them, which the rule leaves out) tested against the probe of e."""
     t = np.asarray(triangles)
     p = x[t]
     out = []
     for e in sample:
         v = np.sort(t[e])
         q = 0.5 * x[v[0]] + 0.3 * x[v[1]] + 0.2 * x[v[2]]
-        inside = np.ones(len(t), bool)
+        inside = np.isin(t, v).any(axis=1)
         for k in range(3):
             a, b = p[:, k], p[:, (k + 1) % 3]
             inside &= (b[:, 0] - a[:, 0]) * (q[1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (
