@@ -1215,46 +1215,48 @@ def _unpack2(v):
 
 
 @ti.func
-def _record(efor: ti.template(), j, sig, sf, wf, de, eps, flag, mult):
-    """What the gather reads of a computed element: one 64-byte line per element
-    (``efor[j, 0]``, j = ``eidx[a, s]``, see :func:`record_slots`), weighted by the
-    multiplicity w: the stress (0–3); the weight
+def _record(efor: ti.template(), j, sig, sf, wf, de, eps, flag, mult, b, c):
+    """What the gather reads of the computed element (a, b, c): one 64-byte line per
+    element (``efor[j]``, j = ``eidx[a, s]``, see :func:`record_slots`; the records
+    lie side by side), weighted by the multiplicity w: the stress (0–3); the weight
     1/N_e of the nodal forces (4; 0 for an element whose forces another pass
     writes); rounded to f32 and packed two to a slot (:func:`_pack2`), the strain
     increment (5: xx, yy; 6: xy) and the plastic shear strain increment (6, ≥ 0,
-    marked for a failed element); 1 in slot 7 when the stress of the nodal forces
-    ``sf`` is not the stress (viscous stress, bulk viscosity), which then fills a
-    second line (``efor[j, 1]``, xx, yy, xy). The gather makes each corner's force
-    from these and the positions of the other two corners (:func:`_corner_force`)."""
+    marked for a failed element); in the bits of slot 7, the corners b (bits 0–30)
+    and c (32–62), and in bit 31 whether the stress of the nodal forces ``sf`` is
+    not the stress (viscous stress, bulk viscosity), which then fills a second line
+    in the upper half of the array (``efor[C + j]``, C = half its size; xx, yy, xy).
+    The gather makes each corner's force from these and the positions of the other
+    two corners (:func:`_corner_force`), without looking the element up."""
     w = ti.cast(mult, ti.f64)
     ws = w * sig
     d01 = _pack2(w * de[0], w * de[1], 0)
     d2e = _pack2(w * de[2], ti.abs(w * eps), flag)
-    two = 0.0
+    bits = ti.cast(b, ti.i64) | (ti.cast(c, ti.i64) << 32)
     if sf[0] != sig[0] or sf[1] != sig[1] or sf[2] != sig[2]:
-        two = 1.0
-        efor[j, 1] = ti.Vector([w * sf[0], w * sf[1], w * sf[2], 0.0, 0.0, 0.0, 0.0, 0.0])
-    efor[j, 0] = ti.Vector([ws[0], ws[1], ws[2], ws[3], wf, d01, d2e, two])
+        bits = bits | (ti.cast(1, ti.i64) << 31)
+        efor[efor.shape[0] // 2 + j] = ti.Vector([w * sf[0], w * sf[1], w * sf[2], 0.0, 0.0,
+                                                  0.0, 0.0, 0.0])
+    efor[j] = ti.Vector([ws[0], ws[1], ws[2], ws[3], wf, d01, d2e, ti.bit_cast(bits, ti.f64)])
 
 
 @ti.func
-def _corner_force(k, o, s, j, r, pos: ti.template(), elem: ti.template(),
-                  efor: ti.template()):
-    """The force of element (o, s) on its corner k (of (o, b, c), counter-clockwise)
-    from its record line r = ``efor[j, 0]`` (:func:`_record`):
-    :func:`physics.fvm.corner_force` with
-    the stress of the forces (times the multiplicity), the weight 1/N_e and the
-    positions of the other two corners."""
-    b = elem[o, s, 0]
-    c = elem[o, s, 1]
+def _corner_force(k, o, j, r, pos: ti.template(), efor: ti.template()):
+    """The force of the element (o, b, c) (counter-clockwise, created by o) on its
+    corner k from its record line r = ``efor[j]`` (:func:`_record`, which holds b and
+    c): :func:`physics.fvm.corner_force` with the stress of the forces (times the
+    multiplicity), the weight 1/N_e and the positions of the other two corners."""
+    bits = ti.bit_cast(r[7], ti.i64)
+    b = ti.cast(bits & ti.i64(0x7FFFFFFF), ti.i32)
+    c = ti.cast(bits >> 32, ti.i32)
     u, v = b, c
     if k == 1:
         u, v = c, o
     elif k == 2:
         u, v = o, b
     sf = ti.Vector([r[0], r[1], r[2], 0.0])
-    if r[7] != 0.0:
-        r2 = efor[j, 1]
+    if (bits >> 31) & 1 != 0:
+        r2 = efor[efor.shape[0] // 2 + j]
         sf = ti.Vector([r2[0], r2[1], r2[2], 0.0])
     return fvm.corner_force(sf, pos[u], pos[v], r[4])
 
@@ -1360,7 +1362,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                         failed = 1
                     sig, eps, flag = mc_correct_state(sig, matp, M, failed)
                 esig[a, s] = sig
-                _finish(a, s, j, M, sig, eps, flag, de, area, cover, matp, emult,
+                _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp, emult,
                         efor, ede, dt, eos)
                 j += 1
 
@@ -1378,7 +1380,7 @@ def _kinematics(a, b, c, pos: ti.template(), vel: ti.template(), dt):
 
 
 @ti.func
-def _finish(a, s, j, M, sig, eps, flag, de, area, cover, matp: ti.template(),
+def _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp: ti.template(),
             emult: ti.template(), efor: ti.template(), ede: ti.template(), dt,
             eos: ti.template()):
     """The end of step 2 for element (a, s) with its corrected stress: the state
@@ -1394,7 +1396,7 @@ def _finish(a, s, j, M, sig, eps, flag, de, area, cover, matp: ti.template(),
     if not _has_eos(matp, M):
         sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
         wf = 1.0 / cover
-    _record(efor, j, sig, sf, wf, de, eps, flag, emult[a, s])
+    _record(efor, j, sig, sf, wf, de, eps, flag, emult[a, s], b, c)
 
 
 @cached
@@ -1464,7 +1466,7 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                         q = d[6] / (d[0] + d[1])
                     sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
                     _record(efor, eidx[a, s], sig, sf, 1.0 / ncov[a, s], de, d[3],
-                            ti.cast(d[4], ti.i32), emult[a, s])
+                            ti.cast(d[4], ti.i32), emult[a, s], b, c)
 
 
 @cached
@@ -1512,8 +1514,8 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 o = code >> 6
                 s = (code >> 2) & 15
                 j = eidx[o, s]
-                r = efor[j, 0]
-                f += _corner_force(code & 3, o, s, j, r, pos, elem, efor)
+                r = efor[j]
+                f += _corner_force(code & 3, o, j, r, pos, efor)
                 ssum += ti.Vector([r[0], r[1], r[2], r[3]])
                 dxx, dyy, _ = _unpack2(r[5])
                 dxy, ep, failed = _unpack2(r[6])

@@ -208,7 +208,7 @@ class Continuum:
         a["earea"] = ti.ndarray(ti.f64, (n, E))
         a["ncov"] = ti.ndarray(ti.i32, (n, E))
         a["esig"] = _arr(4, (n, E))
-        a["efor"] = _arr(8, (n * E, 2))     # records, packed (pcmm.record_slots)
+        a["efor"] = _arr(8, (2 * n * E,))     # records, packed (pcmm.record_slots)
         a["ebase"] = ti.ndarray(ti.i32, (n + 1,))
         a["eidx"] = ti.ndarray(ti.i32, (n, E))
         a["ede"] = _arr(7, (n, E))
