@@ -69,9 +69,13 @@ the epoch's start, a particle built when the largest relative u around it was W
 keeps its elements while the largest relative u around it stays below
 slack − W. When the engine rebuilds its neighbour lists, a particle's new
 candidates (beyond the Eq. 1 cut-off until then, by the engine's skin) add their
-own slack. An epoch begins at the first steps, after a restore and after a step
-that had to rebuild many particles or recount many N_e (the slack left shrinks as
-the u grow).
+own slack. An epoch begins, everything rebuilt, at the first steps and after a
+restore. As the u grow the budgets loosen, so after a step that had to rebuild many
+particles or recount many N_e the epoch is renewed without a rebuild: each budget
+is lowered by the relative u around it and the u restart from zero. A particle
+that rebuilds and finds the same Eq. 1 list and elements (most of them: a
+particle near a threshold rebuilds often, and the answers seldom flip) changes
+nothing around it; only a change marks its neighbourhood for the bookkeeping.
 
 Arrays
 ------
@@ -771,10 +775,11 @@ P_NEW = 4        # 1: this step begins an epoch
 P_REBUILT = 5    # particles that rebuilt their elements this step
 P_RECOUNT = 6    # elements whose N_e was recounted this step
 P_BUILT = 7      # 1: the candidates were rebuilt this step (the engine rebuilt its lists)
-PFLAGS_SIZE = 8
-PFLAGS_INIT = (0, -1, 0, 0, 1, 0, 0, 0)
-EPOCH_REBUILT = 0.05   # a new epoch begins after a step that rebuilt this fraction
-EPOCH_RECOUNT = 0.10   # ... or recounted N_e of this many elements per particle
+P_SOFT = 8       # 1: this step renews the epoch (displacements)
+PFLAGS_SIZE = 9
+PFLAGS_INIT = (0, -1, 0, 0, 1, 0, 0, 0, 0)
+EPOCH_REBUILT = 0.01   # the epoch is renewed after a step that rebuilt this fraction
+EPOCH_RECOUNT = 0.02   # ... or recounted N_e of this many elements per particle
 FLUID_CORE = 0.75  # λ of fluid_core_force
 CARRIED = -1.0     # a pair history's overlap entry while elements carry the pair (_set_skip)
 MAX_INCIDENT = 64  # slots of a particle's list of the elements containing it
@@ -895,6 +900,8 @@ def _corner(o, e1, e2, i):
     return c
 
 
+REBUILT_CHANGED = 1  # prb: the particle rebuilt, and its Eq. 1 list or elements changed
+REBUILT_SAME = 2     # prb: it rebuilt and found the same Eq. 1 list and elements
 SLACK_FLOOR = 1e-9   # relative to the radius: slack below this counts as none
 
 
@@ -903,20 +910,28 @@ SLACK_FLOOR = 1e-9   # relative to the radius: slack below this counts as none
 def displacements(pos: ti.types.ndarray(), pmat: ti.types.ndarray(),
                   xref: ti.types.ndarray(), pu: ti.types.ndarray(),
                   pflags: ti.types.ndarray(), full: ti.i32, serial: ti.template()):
-    """0. u_i = |x_i − x_ref,i|, the distance each particle has moved since the
-    epoch began. An epoch begins (x_ref = x, everything rebuilt) at the first step,
-    after a restore and after a step in which many particles rebuilt or many
-    elements were recounted (the slack left shrinks as the u grow:
-    ``EPOCH_REBUILT``, ``EPOCH_RECOUNT``). ``P_BUILT``: the candidates were rebuilt
-    this step."""
+    """0. u_i = x_i − x_ref,i, the displacement of each particle since the epoch
+    began. An epoch begins with everything rebuilt (x_ref = x) at the first step and
+    after a restore. The budgets of the rules' slacks bound the *relative*
+    displacements since a particle was built (``pbud``) or an element counted
+    (``ebud``) by the relative u then plus the relative u now, so they loosen as the
+    u grow. After a step in which many particles rebuilt or many elements were
+    recounted (``EPOCH_REBUILT``, ``EPOCH_RECOUNT``) the next step renews the epoch
+    instead (``P_SOFT``), with no rebuild: each budget is lowered by the relative u
+    around it then (|r(t) − r(t_b)| ≤ |r(t) − r(t_e)| + |r(t_e)| + |r(t_b)|; a
+    particle built or an element counted at the renewal keeps its whole slack) by
+    :func:`rebuild_elements` and :func:`stresses`, and x_ref = x by
+    :func:`mark_dirty`. ``P_BUILT``: the candidates were rebuilt this step."""
     n = pos.shape[0]
     ti.loop_config(serialize=True)
     for _ in range(1):
-        new = 0
-        if full != 0 or pflags[P_REBUILT] > EPOCH_REBUILT * n or \
-                pflags[P_RECOUNT] > EPOCH_RECOUNT * n:
-            new = 1
+        new = 1 if full != 0 else 0
+        soft = 0
+        if new == 0 and (pflags[P_REBUILT] > EPOCH_REBUILT * n or
+                         pflags[P_RECOUNT] > EPOCH_RECOUNT * n):
+            soft = 1
         pflags[P_NEW] = new
+        pflags[P_SOFT] = soft
         pflags[P_BUILT] = 1 if pflags[P_EPOCH] != pflags[P_BUILDS] else 0
         pflags[P_EPOCH] = pflags[P_BUILDS]
         pflags[P_REBUILT] = 0
@@ -976,7 +991,9 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
     set. With u the distances moved since the epoch began, a particle built when the
     largest u around it was W keeps its elements while the largest u around it stays
     below slack − W (``pbud``; |x(t) − x(t_b)| ≤ u(t) + u(t_b)); otherwise, and at the
-    start of an epoch, it rebuilds (``prb`` = 1). A rebuilt particle keeps its last
+    start of an epoch, it rebuilds (``prb`` ≠ 0: ``REBUILT_SAME`` when its Eq. 1 list
+    and elements came out as they were, the usual case of a particle near one of
+    the rules' thresholds, else ``REBUILT_CHANGED``). A rebuilt particle keeps its last
     elements and their stresses in the ``_old`` arrays and points each new slot at
     the old slot of the same element (``esrc``, −1 for a new one); the stress of a
     copy is read from its computed copy (``emult``, ``ecopy`` of last step, see
@@ -984,6 +1001,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
     """
     new = pflags[P_NEW] != 0
     built = pflags[P_BUILT] != 0
+    soft = pflags[P_SOFT] != 0
     ti.loop_config(serialize=serial)
     for i in range(pos.shape[0]):
         m = pmat[i]
@@ -1012,7 +1030,6 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                             pbud[i] = ti.min(pbud[i], _dist_slack(d, cut) - (pu[j] - ui).norm()
                                              - SLACK_FLOOR * rad[i])
             if new or umax >= pbud[i]:
-                prb[i] = 1
                 if not new:
                     ti.atomic_add(pflags[P_REBUILT], 1)
                 xi = pos[i]
@@ -1020,14 +1037,19 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                 tol = mtol[m]
                 slack = 1e300
                 cnt = 0
+                same = not new      # the same Eq. 1 list and elements as before
                 for q in range(ccnt[i]):
                     j = cand[i, q]
                     d = (pos[j] - xi).norm()
                     cut = ri + rad[j] + tol
                     slack = ti.min(slack, _dist_slack(d, cut))
                     if d <= cut:
+                        if cnt >= ncnt[i] or nbr[i, cnt] != j:
+                            same = False
                         nbr[i, cnt] = j
                         cnt += 1
+                if cnt != ncnt[i]:
+                    same = False
                 ncnt[i] = cnt
                 ecnt_old[i] = ecnt[i]
                 for s in range(ecnt[i]):
@@ -1044,8 +1066,15 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                                 elem_old[i, so, 1] == elem[i, s, 1]:
                             src = so
                     esrc[i, s] = src
+                    if src != s:
+                        same = False
+                if ne != ecnt_old[i]:
+                    same = False
+                prb[i] = REBUILT_SAME if same else REBUILT_CHANGED
                 slack = ti.min(slack, ti.min(rs, cs))
-                pbud[i] = slack - umax - SLACK_FLOOR * ri
+                pbud[i] = slack - (0.0 if soft else umax) - SLACK_FLOOR * ri
+            elif soft:
+                pbud[i] -= umax
         else:
             ncnt[i] = 0
             ecnt[i] = 0
@@ -1056,25 +1085,31 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
 def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
                pu: ti.types.ndarray(), prb: ti.types.ndarray(), pdirty: ti.types.ndarray(),
                unb: ti.types.ndarray(), pstate: ti.types.ndarray(), pfail: ti.types.ndarray(),
+               pos: ti.types.ndarray(), xref: ti.types.ndarray(), pflags: ti.types.ndarray(),
                serial: ti.template()):
-    """1a. ``pdirty``: the particle or one of its Eq. 1 neighbours rebuilt (every
-    vertex of an element containing i is one of them, so the multiplicities, the
-    copies and the list of elements containing i can only have changed there);
+    """1a. ``pdirty``: the Eq. 1 list or the elements of the particle or of one of
+    its Eq. 1 neighbours changed (``REBUILT_CHANGED``; every vertex of an element
+    containing i is one of them, and the lists are exact every step, so the
+    multiplicities, the copies and the list of elements containing i can only have
+    changed there);
     ``unb``: the largest u over the particle and its Eq. 1 neighbours; ``pfail``:
     the particle has failed (``pstate[i][1]``, compact for the stress pass)."""
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
-        d = prb[i]
+        d = 1 if prb[i] == REBUILT_CHANGED else 0
         u2 = 0.0
         pfail[i] = 1 if pstate[i][1] > 0.0 else 0
         if pmat[i] >= 0:
             ui = pu[i]
             for q in range(ncnt[i]):
                 j = nbr[i, q]
-                d = ti.max(d, prb[j])
+                if prb[j] == REBUILT_CHANGED:
+                    d = 1
                 u2 = ti.max(u2, (pu[j] - ui).norm_sqr())
         pdirty[i] = d
         unb[i] = ti.sqrt(u2)    # the largest distance (the square root is monotonic)
+        if pflags[P_SOFT] != 0:
+            xref[i] = pos[i]    # the renewed epoch (u is read no more this step)
 
 
 @cached
@@ -1336,6 +1371,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     forces with the weight 1/N_e (Eqs. 13–14, sign fixed; :func:`_record`), in the
     next place of the particle's run of records (``eidx``, :func:`record_slots`)."""
     new = pflags[P_NEW] != 0
+    soft = pflags[P_SOFT] != 0
     ti.loop_config(serialize=serial)
     for a in range(pmat.shape[0]):
         j = ebase[a]
@@ -1355,7 +1391,9 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     ncov[a, s] = cv
                     if not new:
                         ti.atomic_add(pflags[P_RECOUNT], 1)
-                    ebud[a, s] = sl - uw - SLACK_FLOOR * rad[a]
+                    ebud[a, s] = sl - (0.0 if soft else uw) - SLACK_FLOOR * rad[a]
+                elif soft:
+                    ebud[a, s] -= uw
                 grad, de, area = _kinematics(a, b, c, pos, vel, dt)
                 M = pmat[a]
                 kind = ti.cast(matp[M, 0], ti.i32)
@@ -1627,7 +1665,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
                      a["esrc"], a["emult"], a["ecopy"], a["pu"], a["pbud"], a["prb"],
                      a["pflags"], serial)
     mark_dirty(a["pmat"], a["nbr"], a["ncnt"], a["pu"], a["prb"], a["pdirty"], a["unb"],
-               a["pstate"], a["pfail"], serial)
+               a["pstate"], a["pfail"], e["pos"], a["xref"], a["pflags"], serial)
     copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], a["prb"],
            a["esig"], serial)
     incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
