@@ -272,8 +272,11 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             if ti.static(serial):
                 j = nbr[i, k]
                 facc[j] += ti.Vector([-fk[0], -fk[1], mjk])
-            if ti.static(detail or not serial):
+            if ti.static(detail):
                 cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
+            elif ti.static(not serial):
+                if skip != 1:      # (a carried pair's share is not read, see 2.)
+                    cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
         fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
                                          whist, wcn, wcf, wcs, dt)
         own = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw])
@@ -298,9 +301,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 flat = rev[i, r]
                 j = flat >> bits
                 k = flat & (cap - 1)
-                c = cf[j, k]
-                f -= ti.Vector([c[0], c[1]])
-                tq += c[2]
+                carried = False
+                if ti.static(continuum):
+                    carried = cskip[j, k] == 1
+                if not carried:
+                    c = cf[j, k]
+                    f -= ti.Vector([c[0], c[1]])
+                    tq += c[2]
         if ti.static(continuum):
             f += xforce[i]
         m = prop[i][1]
