@@ -270,8 +270,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             tq += mk
             diss += dk
             if ti.static(serial):
-                j = nbr[i, k]
-                facc[j] += ti.Vector([-fk[0], -fk[1], mjk])
+                if skip != 1:
+                    j = nbr[i, k]
+                    facc[j] += ti.Vector([-fk[0], -fk[1], mjk])
             if ti.static(detail):
                 cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
             elif ti.static(not serial):
