@@ -630,11 +630,6 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
         cen = 0.5 * (s[0] + s[1])
         d = 0.5 * (s[0] - s[1])
         rad = ti.sqrt(d * d + s[2] * s[2])
-        c2 = 1.0
-        s2 = 0.0
-        if rad > 0.0:
-            c2 = d / rad
-            s2 = s[2] / rad
         p = ti.Vector([cen - rad, cen + rad, s[3]])
         # sorted: i1 (most compressive), i3 (most tensile)
         i1 = 0
@@ -717,6 +712,11 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
                     if shear_part == 1:
                         flag = SHEAR_FAILURE
             # back to x–y
+            c2 = 1.0
+            s2 = 0.0
+            if rad > 0.0:
+                c2 = d / rad
+                s2 = s[2] / rad
             cn = 0.5 * (q[0] + q[1])
             rn = 0.5 * (q[1] - q[0])
             out = ti.Vector([cn + rn * c2, cn - rn * c2, rn * s2, q[2]])
