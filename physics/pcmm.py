@@ -1093,7 +1093,8 @@ def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types
     multiplicities, the copies and the list of elements containing i can only have
     changed there);
     ``unb``: the largest u over the particle and its Eq. 1 neighbours; ``pfail``:
-    the particle has failed (``pstate[i][1]``, compact for the stress pass)."""
+    the particle has failed (``pstate[i][1]``, compact for the stress pass); in a
+    step that renews the epoch (``P_SOFT``, see :func:`displacements`), x_ref = x."""
     ti.loop_config(serialize=serial)
     for i in range(pmat.shape[0]):
         d = 1 if prb[i] == REBUILT_CHANGED else 0
