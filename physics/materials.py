@@ -92,6 +92,9 @@ any material from one 2D array ``matp[M, col]``:
 11    dynamic viscosity μ (Pa·s)              (Fluid, else 0)
 12    linear artificial bulk viscosity b1      (Fluid, JWL; else 0)
 13    quadratic artificial bulk viscosity b2   (Fluid, JWL; else 0)
+14    √N_φ                                     (Mohr–Coulomb, else 0: columns 14–16
+15    a_p = √(1 + N_φ²) + N_φ (FLAC's split)    are constants of the return mapping)
+16    Δe^ps/Δγ of the shear return
 ====  ==============================================================
 
 A JWL row uses columns 4–10 for A, B, R1, R2, ω, E0 (Pa) and D (m/s); its column 2
@@ -113,7 +116,7 @@ from tdem.errors import InputError
 
 from .validate import in_range, non_negative, positive
 
-MAT_WIDTH = 14
+MAT_WIDTH = 17
 ELASTIC, MOHR_COULOMB, FLUID, JWL_TYPE = 0, 1, 2, 3
 NO_FAILURE, SHEAR_FAILURE, TENSION_FAILURE = 0, 1, 2
 
@@ -198,7 +201,7 @@ class Elastic(Material):
 
     def row(self):
         return [float(ELASTIC), self.density, self.bulk, self.shear,
-                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+                0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
 
 
 class MohrCoulomb(Material):
@@ -272,7 +275,16 @@ class MohrCoulomb(Material):
         return [float(MOHR_COULOMB), self.density, self.bulk, self.shear,
                 self.cohesion, self.tension, self.n_phi, self.n_psi,
                 1.0 if self.brittle else 0.0, self.residual_cohesion,
-                self.residual_tension, 0.0, 0.0, 0.0]
+                self.residual_tension, 0.0, 0.0, 0.0] + self._return_constants()
+
+    def _return_constants(self):
+        """Columns 14–16, constants of the return mapping (``mc_correct_state``):
+        √N_φ, FLAC's a_p = √(1 + N_φ²) + N_φ, and Δe^ps/Δγ of the shear return."""
+        nphi, npsi = self.n_phi, self.n_psi
+        mu = (npsi - 1.0) / 3.0
+        return [math.sqrt(nphi), math.sqrt(1.0 + nphi * nphi) + nphi,
+                math.sqrt(0.5 * ((1.0 + mu) * (1.0 + mu) + (npsi - mu) * (npsi - mu)
+                                 + mu * mu))]
 
 
 class Fluid(Material):
@@ -360,7 +372,7 @@ class Fluid(Material):
         return [float(FLUID), self.density, self.bulk, 0.0,
                 1.0 if self.equation_of_state else 0.0, self.tensile_strength, 1.0, 1.0,
                 0.0, 0.0, 0.0, self.viscosity,
-                self.linear_viscosity, self.quadratic_viscosity]
+                self.linear_viscosity, self.quadratic_viscosity, 0.0, 0.0, 0.0]
 
 
 class JWL(Material):
@@ -431,7 +443,7 @@ class JWL(Material):
     def row(self):
         return [float(JWL_TYPE), self.density, self.bulk, 0.0,
                 self.A, self.B, self.R1, self.R2, self.omega, self.E0, self.D, 0.0,
-                self.linear_viscosity, self.quadratic_viscosity]
+                self.linear_viscosity, self.quadratic_viscosity, 0.0, 0.0, 0.0]
 
 
 @ti.func
@@ -623,7 +635,7 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
             ten = matp[M, 10]
         nphi = matp[M, 6]
         npsi = matp[M, 7]
-        sq = ti.sqrt(nphi)
+        sq = matp[M, 14]
         a1 = K + 4.0 * G / 3.0
         a2 = K - 2.0 * G / 3.0
         # in-plane principal values a ≤ b, direction (cos 2θ, sin 2θ) of b
@@ -648,7 +660,7 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
             scale = ti.abs(p[0]) + ti.abs(p[1]) + ti.abs(p[2]) + coh + ten
             tol = 1e-12 * scale
             # FLAC's domain split
-            ap = ti.sqrt(1.0 + nphi * nphi) + nphi
+            ap = matp[M, 15]
             sp = ten * nphi - 2.0 * coh * sq
             h = s3 - ten + ap * (s1 - sp)
             # FLAC's one-plane return, in closed form: Δγ = F/(n·D m), q = p − Δγ D m
@@ -664,10 +676,8 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
                 d1 = d2 - (a1 - a2)
                 d3 = d2 + (a1 - a2) * npsi
                 g1 = -fs / (nphi * d3 - d1)
-                # Δe^ps = Δγ·sqrt(½ |m − mean(m)|²)
-                mu = (npsi - 1.0) / 3.0
-                eps = g1 * ti.sqrt(0.5 * ((1.0 + mu) * (1.0 + mu) + (npsi - mu) * (npsi - mu)
-                                          + mu * mu))
+                # Δe^ps = Δγ·sqrt(½ |m − mean(m)|²), m = (−1, N_ψ, 0) by rank
+                eps = g1 * matp[M, 16]
                 flag = SHEAR_FAILURE
             else:
                 # tension plane i3: F = s_i3 − T, m_i3 = 1

@@ -1007,10 +1007,13 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
         m = pmat[i]
         prb[i] = 0
         if m >= 0:
-            umax = 0.0
+            # the largest relative u: one square root (monotone and correctly
+            # rounded: the root of the largest square is the largest root)
+            umax2 = 0.0
             ui = pu[i]
             for q in range(ccnt[i]):
-                umax = ti.max(umax, (pu[cand[i, q]] - ui).norm())
+                umax2 = ti.max(umax2, (pu[cand[i, q]] - ui).norm_sqr())
+            umax = ti.sqrt(umax2)
             if built and not new:
                 # new candidates: the particles not listed before stayed beyond the
                 # Eq. 1 cut-off until now (the engine's skin); from now on each keeps
@@ -1383,10 +1386,18 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                 c = elem[a, s, 1]
                 v0, v1, v2 = _sorted3(a, b, c)
                 u0 = pu[v0]
-                uw = ti.max(unb[v0], ti.max(unb[v1] + (pu[v1] - u0).norm(),
-                                            unb[v2] + (pu[v2] - u0).norm()))
+                d1 = pu[v1] - u0
+                d2 = pu[v2] - u0
+                # uw, or an upper bound of it with one square root where that bound
+                # already says the count stands (the usual case)
+                eb = ebud[a, s]
+                need = new or pdirty[v0] + pdirty[v1] + pdirty[v2] > 0
+                uw = ti.max(unb[v0], ti.max(unb[v1], unb[v2])
+                            + ti.sqrt(ti.max(d1.norm_sqr(), d2.norm_sqr())))
+                if need or soft or uw >= eb:
+                    uw = ti.max(unb[v0], ti.max(unb[v1] + d1.norm(), unb[v2] + d2.norm()))
                 cover = ncov[a, s]
-                if new or pdirty[v0] + pdirty[v1] + pdirty[v2] > 0 or uw >= ebud[a, s]:
+                if need or uw >= eb:
                     cv, sl = _cover_incident(v0, v1, v2, pos, elem, inc, icnt, emult)
                     cover = cv
                     ncov[a, s] = cv
