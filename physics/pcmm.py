@@ -1385,17 +1385,16 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
                 v0, v1, v2 = _sorted3(a, b, c)
-                u0 = pu[v0]
-                d1 = pu[v1] - u0
-                d2 = pu[v2] - u0
-                # uw, or an upper bound of it with one square root where that bound
-                # already says the count stands (the usual case)
+                # uw, or where it already says the count stands (the usual case) an
+                # upper bound of it: v1 and v2 are Eq. 1 neighbours of v0, so their
+                # u relative to v0 are at most unb[v0] (bitwise: the same roots)
                 eb = ebud[a, s]
                 need = new or pdirty[v0] + pdirty[v1] + pdirty[v2] > 0
-                uw = ti.max(unb[v0], ti.max(unb[v1], unb[v2])
-                            + ti.sqrt(ti.max(d1.norm_sqr(), d2.norm_sqr())))
+                uw = unb[v0] + ti.max(unb[v1], unb[v2])
                 if need or soft or uw >= eb:
-                    uw = ti.max(unb[v0], ti.max(unb[v1] + d1.norm(), unb[v2] + d2.norm()))
+                    u0 = pu[v0]
+                    uw = ti.max(unb[v0], ti.max(unb[v1] + (pu[v1] - u0).norm(),
+                                                unb[v2] + (pu[v2] - u0).norm()))
                 cover = ncov[a, s]
                 if need or uw >= eb:
                     cv, sl = _cover_incident(v0, v1, v2, pos, elem, inc, icnt, emult)
