@@ -10,8 +10,9 @@ A model is described by a small dict ``spec``:
   ``inset`` None puts the outermost centres R from the edges, 0 puts them on the
   edges; cross ``fit`` True shrinks the spacings so that the rows end on the edges);
 - ``{"kind": "random", "rmin": .., "rmax": .., "tolerance": δ, "fraction": 0.8,
-  "edge_centres": False}`` (``tdem.pack.random``, seed 0; ``edge_centres`` True
-  puts the boundary discs' centres on the edges);
+  "overlap_tol": 1e-3, "edge_centres": False, "seed": 0}`` (``tdem.pack.random``;
+  ``edge_centres`` True puts the boundary discs' centres on the edges; a fraction
+  above jamming needs a larger ``overlap_tol``);
 - ``{"kind": "fvm", "cells": (nx, ny), "pattern": "regular" | "cross"}``
   (``tdem.mesh.rectangle`` block).
 """
@@ -74,7 +75,8 @@ class Model:
                         pos, r = tdem.pack.random(W, H, spec["rmin"], spec["rmax"],
                                                   seed=spec.get("seed", 0),
                                                   target_fraction=frac, origin=origin,
-                                                  edge_centres=spec.get("edge_centres", False))
+                                                  edge_centres=spec.get("edge_centres", False),
+                                                  overlap_tol=spec.get("overlap_tol", 1e-3))
                         break
                     except tdem.InputError:
                         if frac <= 0.6:

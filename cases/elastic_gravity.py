@@ -17,8 +17,11 @@ simulation and output subfolder:
   the sides of its element body are notched (odd rows end 0.56 m inside), 388.9 m²;
 - random PCMM: R = 0.168-0.312 m, δ = 0.3 m, ``tdem.pack.random`` with
   ``edge_centres=True`` (discs centred on the four edges and corners, the rest
-  packed inside) at 80 % area fraction (the paper's GiD packing has 1966, which at
-  these radii would be an area fraction of about 0.9, above jamming);
+  packed inside) at 89 % area fraction, the paper's count (its GiD packing has
+  1966 discs; here 1995): denser than jamming, so neighbouring discs overlap
+  (by 0.10 rmin on average, at most 0.7 rmin: ``overlap_tol``). At 80 % (1787, no
+  overlaps) the voids left chains of holes in the element cover (4 % of the
+  area) and the body came out up to 14 % softer than the FVM block, by the seed;
 - FVM block: 20 × 20 cells of 1 × 1 m, each split into two triangles (800
   triangles; the paper counts 400 elements = cells).
 
@@ -26,15 +29,16 @@ So every model spans 0-20 m in both directions, as the FVM block does. Support
 and sides are the same for all: the particles / nodes on y = 0 are fixed
 (vx = vy = 0), the sides and the top are free. Masses: the PCMM cluster masses
 (Eq. 5) add up to ρ·(element area) (the summary's
-``weight_rel_to_rho_g_element_area``: 1 for the lattices, 1.002 random), and the
+``weight_rel_to_rho_g_element_area``: 1 to round-off for all three), and the
 fixed row's reaction equals the weight.
 
 Run to static equilibrium with local damping α' = 0.8 (dt = 0.5 × the critical
 step): chunks of 250 steps until the mean vertical displacement of the top row
 changes by less than 1e-4 (relative) over two chunks in a row, at most 3000
 steps (quick) or 8000 (paper). The FVM block and the lattices converge in
-1250-2000 steps, the random packing in about 3000; run on to 6000 steps, u_y and
-σ_yy at the monitors change by less than 0.1 % (no creep).
+1250-2000 steps, the random packing in 2250 (quick) and 4500 (paper); run on to
+6000 steps, u_y and σ_yy at the monitors changed by less than 0.1 % (no creep; the
+lattices and the earlier, 80 % random packing).
 
 Read-out
 --------
@@ -59,8 +63,8 @@ summary gives each model's difference from this reference too
 (``sigma_yy_rel_diff_from_elastic_reference``) and Fig. 10 shows it (crosses).
 
 Presets: ``quick`` uses the paper's sizes for regular, cross and FVM and a
-coarser random packing (R = 0.336-0.624 m, δ = 0.6 m, 452 particles); ``paper`` uses
-the paper's radii for all four.
+coarser random packing (R = 0.336-0.624 m, δ = 0.6 m, about 490 particles at the
+same fraction); ``paper`` uses the paper's radii for all four.
 
 Outputs (``--out DIR``, default out/elastic_gravity): one subfolder per model with
 its VTU series (.pvd) and monitors.h5; ``histories.h5`` (profiles of all models);
@@ -88,17 +92,19 @@ _REGULAR = {"kind": "regular", "radius": 0.5, "tolerance": 0.5, "inset": 0.0}
 _CROSS = {"kind": "cross", "radius": math.sqrt(3.0) / 3.0, "tolerance": 0.01,
           "inset": 0.0, "fit": True}
 _FVM = {"kind": "fvm", "cells": (20, 20), "pattern": "regular"}
+# the random packings at the paper's count (about 1966 discs of R = 0.168-0.312 m)
+_DENSE = {"fraction": 0.89, "overlap_tol": 0.7}
 MODELS = {
     "quick": {
         "regular": _REGULAR, "cross": _CROSS,
         "random": {"kind": "random", "rmin": 0.336, "rmax": 0.624, "tolerance": 0.6,
-                   "edge_centres": True},
+                   "edge_centres": True, **_DENSE},
         "fvm": _FVM,
     },
     "paper": {
         "regular": _REGULAR, "cross": _CROSS,
         "random": {"kind": "random", "rmin": 0.168, "rmax": 0.312, "tolerance": 0.3,
-                   "edge_centres": True},
+                   "edge_centres": True, **_DENSE},
         "fvm": _FVM,
     },
 }

@@ -82,8 +82,9 @@ def test_elastic_gravity_fvm_matches_the_elastic_solution(gravity):
 @pytest.mark.parametrize("model, tol", [("regular", 0.01), ("cross", 0.01), ("random", 0.10)])
 def test_elastic_gravity_pcmm_stress_follows_the_elastic_solution(gravity, model, tol):
     """Regular and cross lattices within 1 % (of rho g (H - y)) of the elastic
-    solution at every monitor; the coarse random packing within 10 % (measured 8.4 %
-    at y = 16 m: its fit over scattered particles is noisier)."""
+    solution at every monitor; the coarse random packing within 10 %: its particle
+    stresses scatter (measured 1.9 % for the case's packing, up to 9 % at one
+    monitor for other seeds)."""
     m = gravity["models"][model]
     diff = np.asarray(m["sigma_yy_rel_diff_from_elastic_reference"]["value"])
     away = np.asarray(gravity["monitor_y"]) >= elastic_gravity.BASE_Y
@@ -99,7 +100,7 @@ _EXACT = ("the plane-strain elastic solution of the fixed-base 20 x 20 m square 
     pytest.param("fvm", marks=pytest.mark.xfail(reason=_EXACT, strict=True)),
     pytest.param("regular", marks=pytest.mark.xfail(reason=_EXACT, strict=True)),
     pytest.param("cross", marks=pytest.mark.xfail(reason=_EXACT, strict=True)),
-    "random"])
+    pytest.param("random", marks=pytest.mark.xfail(reason=_EXACT, strict=True))])
 def test_elastic_gravity_sigma_yy_within_5_percent_of_rho_g_depth(gravity, model):
     """The issue's stress target: within 5 % of -rho g (H - y) at y >= 4 m."""
     m = gravity["models"][model]
