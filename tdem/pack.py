@@ -260,10 +260,10 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     to 14 % softer under its own weight and leave σ_yy at a point as low as 0.43 of
     its elastic value). The same square at 0.89 with ``overlap_tol=0.7`` (1990–2003
     discs by the seed, the count of Feng et al.'s random model; overlaps of
-    0.10–0.14 rmin on average, 0.31–0.52 rmin at the 99th percentile) packs in 1–5 s,
-    and its elements cover 98.8–99.9 % of it (seeds 0–3). The relaxation stops as soon as
-    no overlap exceeds ``overlap_tol``, so a tighter one gives more even overlaps
-    where it can be reached (0.25 is reached for seed 0 only).
+    0.10–0.14 rmin on average, 0.31–0.52 rmin at the 99th percentile) packs in
+    1–5 s, and its elements cover 98.8–99.9 % of it (seeds 0–3). The relaxation
+    stops as soon as no overlap exceeds ``overlap_tol``, so a tighter one gives
+    more even overlaps where it can be reached (0.25 is reached for seed 0 only).
 
     ``edge_centres=True`` first lines the boundary with discs whose centres lie on
     it, as the boundary nodes of a mesh: a disc on every vertex, and along each
