@@ -126,12 +126,12 @@ def uy_analytic(y):
     return -RHO * G * (1.0 - NU * NU) / E * (H * y - 0.5 * y * y)
 
 
-def elastic_reference(ys, n=40):
-    """(u_y, σ_yy) at (X_MON, y) of the plane-strain linear-elastic solution of the
-    same problem (fixed base, free sides and top, own weight) by bilinear
-    quadrilaterals on an n × n grid (2 × 2 Gauss points, consistent body force,
-    dense solve); σ_yy by a linear fit over the cell centres near the point. The
-    40 × 40 and 20 × 20 grids agree within 0.3 % (of ρ·g·(H − y)) at the monitors."""
+def elastic_field(n=40):
+    """The plane-strain linear-elastic solution of the problem (fixed base, free
+    sides and top, own weight) by bilinear quadrilaterals on an n × n grid (2 × 2
+    Gauss points, consistent body force, dense solve). Returns (node points (P, 2),
+    u (P, 2), cell centres (n², 2), cell-centre stress (n², 3): σxx, σyy, σxy,
+    tension-positive); cell k lies in row k // n from the base."""
     h = W / n
     lam = E * NU / ((1 + NU) * (1 - 2 * NU))
     mu = E / (2 * (1 + NU))
@@ -164,10 +164,16 @@ def elastic_reference(ys, n=40):
     u = np.zeros(nd)
     u[free] = np.linalg.solve(K[np.ix_(free, free)], f[free])
     stress = (D @ bmat(0.0, 0.0) @ u[dofs].T).T
-    centres = pts[cells].mean(axis=1)
-    uy = np.array([u[2 * np.argmin(np.hypot(pts[:, 0] - X_MON, pts[:, 1] - y)) + 1]
-                   for y in ys])
-    syy = np.array([linear(centres, stress[:, 1], y, 1.5 * h) for y in ys])
+    return pts, u.reshape(-1, 2), pts[cells].mean(axis=1), stress
+
+
+def elastic_reference(ys, n=40):
+    """(u_y, σ_yy) at (X_MON, y) of :func:`elastic_field`; σ_yy by a linear fit
+    over the cell centres near the point. The 40 × 40 and 20 × 20 grids agree within
+    0.3 % (of ρ·g·(H − y)) at the monitors (``tests/test_pcmm_cases.py``)."""
+    pts, u, centres, stress = elastic_field(n)
+    uy = np.array([u[np.argmin(np.hypot(pts[:, 0] - X_MON, pts[:, 1] - y)), 1] for y in ys])
+    syy = np.array([linear(centres, stress[:, 1], y, 1.5 * W / n) for y in ys])
     return uy, syy
 
 
