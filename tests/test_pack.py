@@ -197,3 +197,83 @@ def test_random_edge_centres():
     assert inside / (W * H) == pytest.approx(0.8, abs=0.02)
     x2, r2 = pack.random(W, H, 0.336, 0.624, seed=0, edge_centres=True)
     np.testing.assert_array_equal(x, x2)
+
+
+def _element_union(x, r, tol):
+    from test_pcmm_elements import union_area
+    from physics.pcmm import ElementSystem
+    return union_area(x, ElementSystem(x, r, tol).build().numpy()["triangles"], h=0.01)
+
+
+def test_fill_holes_puts_a_missing_lattice_disc_back():
+    """A square lattice (R = 0.5, δ = R) with one disc taken out has a diamond-shaped
+    hole in its element cover around the missing centre, clearance R there: one
+    disc of radius R goes back exactly there and the cover is whole again."""
+    x, r = pack.regular(10.0, 10.0, 0.5)
+    k = int(np.argmin(np.hypot(x[:, 0] - 5.5, x[:, 1] - 5.5)))
+    full = _element_union(x, r, 0.5)
+    assert full == pytest.approx(81.0, rel=1e-4)                 # 9 x 9 m of centres
+    xs, rs = np.delete(x, k, axis=0), np.delete(r, k)
+    assert _element_union(xs, rs, 0.5) == pytest.approx(81.0 - 2.0, rel=1e-3)
+    x2, r2 = pack.fill_holes(xs, rs, 0.5, 0.5, 0.5, 10.0, 10.0)
+    assert len(x2) == len(x)
+    np.testing.assert_array_equal(x2[:-1], xs)                   # the others stay
+    np.testing.assert_allclose(x2[-1], [5.5, 5.5], atol=1e-12)
+    assert r2[-1] == 0.5
+    assert _element_union(x2, r2, 0.5) == pytest.approx(full, rel=1e-9)
+
+
+def test_random_pcmm_tolerance_closes_the_element_cover():
+    """The paper's random model (R = 0.168-0.312 m, δ = 0.3 m, 20 x 20 m, 0.89 with
+    overlaps up to 0.7 rmin, centres on the edges; seed 0): its element cover has
+    holes over 1.2 % of the square; with pcmm_tolerance=0.3 a few discs (11) go into
+    them, the cover reaches 99.95 %, and the packing keeps its radius range, overlap
+    bound and region."""
+    rmin, rmax, tol = 0.168, 0.312, 0.7
+    kw = dict(seed=0, target_fraction=0.89, overlap_tol=tol, edge_centres=True)
+    x0, r0 = pack.random(20.0, 20.0, rmin, rmax, **kw)
+    x, r = pack.random(20.0, 20.0, rmin, rmax, pcmm_tolerance=0.3, **kw)
+    assert _element_union(x0, r0, 0.3) < 0.99 * 400.0
+    assert _element_union(x, r, 0.3) >= 0.9995 * 400.0
+    assert 1 <= len(r) - len(r0) <= 0.01 * len(r0)
+    assert np.all((r >= rmin) & (r <= rmax))
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    ov = (r[:, None] + r[None] - d)[np.triu_indices(len(r), 1)]
+    assert ov.max() <= tol * rmin * (1 + 1e-9)
+    assert np.all((x >= -1e-12) & (x <= 20.0 + 1e-12))
+    # the added discs lie inside the square
+    old = {tuple(p) for p in np.round(x0, 12)}
+    added = np.array([p for p in np.round(x, 12) if tuple(p) not in old])
+    ra = r[[tuple(p) not in old for p in np.round(x, 12)]]
+    assert len(added) == len(r) - len(r0)
+    assert np.all((added - ra[:, None] >= 0.0) & (added + ra[:, None] <= 20.0))
+
+
+@pytest.mark.parametrize("call, word", [
+    (lambda: pack.fill_holes([[0.0, 0.0, 0.0]], 0.1, 0.1, 0.1, 0.2, 1.0, 1.0), "positions"),
+    (lambda: pack.fill_holes([[0.5, 0.5]], [0.1, 0.1], 0.1, 0.1, 0.2, 1.0, 1.0), "radii"),
+    (lambda: pack.fill_holes([[0.5, 0.5]], 0.1, -0.1, 0.1, 0.2, 1.0, 1.0), "tolerance"),
+    (lambda: pack.fill_holes([[0.5, 0.5]], 0.1, 0.1, 0.3, 0.2, 1.0, 1.0), "rmax"),
+    (lambda: pack.random(2.0, 2.0, 0.1, 0.2, pcmm_tolerance=float("nan")), "pcmm_tolerance"),
+])
+def test_fill_holes_bad_input_names_the_argument(call, word):
+    with pytest.raises(tdem.InputError, match=word):
+        call()
+
+
+def test_fill_holes_leaves_the_border_strip_unless_asked():
+    """Without discs centred on the boundary the element cover stops at the
+    outermost centres, about a radius inside: that strip is no hole (default), and
+    ``border=True`` fills it too (a slice of the wave_bar's random packing)."""
+    rmin, rmax, delta = 0.0139, 0.0423, 0.05
+    x, r = pack.random(4.0, 0.6, rmin, rmax, seed=0, target_fraction=0.86, overlap_tol=0.7)
+    xa, ra = pack.fill_holes(x, r, delta, rmin, rmax, 4.0, 0.6)
+    xb, rb = pack.fill_holes(x, r, delta, rmin, rmax, 4.0, 0.6, border=True)
+    na, nb = len(ra) - len(r), len(rb) - len(r)
+    assert nb > 3 * na
+    added = xb[len(r):]
+    wall = np.minimum(np.minimum(added[:, 0], 4.0 - added[:, 0]),
+                      np.minimum(added[:, 1], 0.6 - added[:, 1]))
+    assert np.mean(wall < 2 * rmax) > 0.7              # most of them along the walls
+    # the default fills holes inside the cover: the cover grows, the border stays
+    assert _element_union(xa, ra, delta) >= _element_union(x, r, delta)

@@ -79,12 +79,12 @@ def test_elastic_gravity_fvm_matches_the_elastic_solution(gravity):
     assert np.max(np.abs(m["sigma_yy_rel_diff_from_elastic_reference"]["value"])) <= 0.01
 
 
-@pytest.mark.parametrize("model, tol", [("regular", 0.01), ("cross", 0.01), ("random", 0.10)])
+@pytest.mark.parametrize("model, tol", [("regular", 0.01), ("cross", 0.01), ("random", 0.03)])
 def test_elastic_gravity_pcmm_stress_follows_the_elastic_solution(gravity, model, tol):
     """Regular and cross lattices within 1 % (of rho g (H - y)) of the elastic
-    solution at every monitor; the coarse random packing within 10 %: its particle
-    stresses scatter (measured 1.9 % for the case's packing, up to 9 % at one
-    monitor for other seeds)."""
+    solution at every monitor; the coarse random packing within 3 %: its particle
+    stresses scatter (measured 1.9 % for the case's packing, 1.2-2.0 % for seeds
+    1-3 with the holes of the element cover filled, up to 9 % without)."""
     m = gravity["models"][model]
     diff = np.asarray(m["sigma_yy_rel_diff_from_elastic_reference"]["value"])
     away = np.asarray(gravity["monitor_y"]) >= elastic_gravity.BASE_Y
