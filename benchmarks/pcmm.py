@@ -11,9 +11,12 @@ large-deformation regime.
 ``--packing`` chooses the particles: ``regular`` (square lattice, the default),
 ``cross`` (hexagonal lattice, the DEM pack's; the column is √3/2 as high, for the
 same count) or ``random`` (``tdem.pack.random``, radii 0.8–1.2 R at 80 % area
-fraction; about 40,200 particles, 15 s to pack). The square lattice is the
-heaviest: with δ = R both diagonals of each square are element edges, so it holds
-four overlapping elements per particle (N_e = 2), twice the others' two.
+fraction; about 40,200 particles, 15 s to pack) or ``dense`` (the random packing
+a PCMM body wants: 88 % with overlaps up to 0.7 rmin, the holes of its element
+cover filled, ``pcmm_tolerance``; about 45,000 particles, 20 s to pack). The
+square lattice is the heaviest: with δ = R both diagonals of each square are
+element edges, so it holds four overlapping elements per particle (N_e = 2),
+twice the others' two.
 
 Prints particle-steps per second of the PCMM run and of the DEM pack benchmark
 (``pack2d.py``'s workload), and their ratio. The machine's speed drifts, so both
@@ -36,7 +39,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
 
-PACKINGS = ("regular", "cross", "random")
+PACKINGS = ("regular", "cross", "random", "dense")
 
 
 def build(side=200, arch=None, threads=None, packing="regular"):
@@ -49,6 +52,9 @@ def build(side=200, arch=None, threads=None, packing="regular"):
         pos, rad = tdem.pack.cross(w, w * np.sqrt(3.0) / 2.0, r)
     elif packing == "random":
         pos, rad = tdem.pack.random(w, w, 0.8 * r, 1.2 * r, seed=1, target_fraction=0.8)
+    elif packing == "dense":
+        pos, rad = tdem.pack.random(w, w, 0.8 * r, 1.2 * r, seed=1, target_fraction=0.88,
+                                    overlap_tol=0.7, pcmm_tolerance=r)
     else:
         raise ValueError(f"packing must be one of {PACKINGS}, got {packing!r}")
     soil = tdem.MohrCoulomb(density=2000.0, young=10e6, poisson=0.3, cohesion=1e3,
