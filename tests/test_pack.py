@@ -277,3 +277,27 @@ def test_fill_holes_leaves_the_border_strip_unless_asked():
     assert np.mean(wall < 2 * rmax) > 0.7              # most of them along the walls
     # the default fills holes inside the cover: the cover grows, the border stays
     assert _element_union(xa, ra, delta) >= _element_union(x, r, delta)
+
+
+def test_fill_holes_in_a_polygon():
+    """The L-shaped region of test_random_in_a_polygon at 0.75 (its voids leave
+    holes in the element cover of δ = 0.05): the filled packing covers more of it,
+    every added disc lies inside the L and overlaps no disc by more than
+    overlap_tol x rmin."""
+    poly = np.array([[0, 0], [0, 3], [1, 3], [1, 1], [4, 1], [4, 0]], dtype=float)
+    rmin, rmax, delta, tol = 0.05, 0.1, 0.05, 0.5
+    x, r = pack.random(None, None, rmin, rmax, seed=1, target_fraction=0.75, polygon=poly)
+    x2, r2 = pack.fill_holes(x, r, delta, rmin, rmax, polygon=poly, overlap_tol=tol)
+    added, ra = x2[len(x):], r2[len(x):]
+    assert len(added) >= 5
+    np.testing.assert_array_equal(x2[:len(x)], x)
+    assert np.all((ra >= rmin) & (ra <= rmax))
+    assert _element_union(x2, r2, delta) > _element_union(x, r, delta) + 0.05
+    d = np.linalg.norm(added[:, None] - x2[None], axis=2) - ra[:, None] - r2[None]
+    d[np.arange(len(added)), len(x) + np.arange(len(added))] = np.inf
+    assert d.min() >= -tol * rmin * (1 + 1e-9)
+    assert np.all(added - ra[:, None] >= -1e-12)
+    assert np.all(added[:, 0] + ra <= 4.0 + 1e-12) and np.all(added[:, 1] + ra <= 3.0 + 1e-12)
+    gx, gy = 1.0 - added[:, 0], 1.0 - added[:, 1]
+    to_notch = np.where((gx >= 0) & (gy >= 0), np.hypot(gx, gy), np.maximum(gx, gy))
+    assert np.all(to_notch >= ra - 1e-12)
