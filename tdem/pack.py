@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from physics.validate import non_negative as _nonnegative
 from physics.validate import positive as _positive
 
 from .errors import InputError
@@ -393,16 +394,6 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
                      f"overlaps of at most overlap_tol={overlap_tol!r} x rmin in {max_iter} "
                      f"sweeps (largest overlap {worst:.3g} m); lower it or raise "
                      f"overlap_tol")
-
-
-def _nonnegative(name, value):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        v = float("nan")
-    if not (v >= 0.0 and math.isfinite(v)):
-        raise InputError(f"{name} must be a number >= 0, got {value!r}")
-    return v
 
 
 def fill_holes(positions, radii, tolerance, rmin, rmax, width=None, height=None,
