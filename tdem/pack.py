@@ -411,11 +411,10 @@ def fill_holes(positions, radii, tolerance, rmin, rmax, width=None, height=None,
     both sides of it along x and along y; ``border=True`` counts every uncovered
     point of the region, also the strip between the outermost discs and the
     boundary (what a packing with discs centred on the boundary, whose elements
-    reach it, wants: :func:`random` with ``edge_centres`` does so). Repeated
-    (``rounds``) until no hole takes a disc. The
-    discs given are not moved; the added ones follow them (:func:`random` with
-    ``pcmm_tolerance`` lists its discs in rows again after it). Returns (positions,
-    radii)."""
+    reach it, wants: :func:`random` with ``edge_centres`` does so). Repeated, at
+    most ``rounds`` times, until no hole takes a disc. The discs given are not
+    moved; the added ones follow them (:func:`random` with ``pcmm_tolerance`` lists
+    its discs in rows again after it). Returns (positions, radii)."""
     try:
         x = np.array(positions, dtype=float)
         r = np.array(radii, dtype=float)
@@ -432,6 +431,8 @@ def fill_holes(positions, radii, tolerance, rmin, rmax, width=None, height=None,
         raise InputError(f"rmax must be >= rmin, got rmin={rmin!r}, rmax={rmax!r}")
     tolerance = _nonnegative("tolerance", tolerance)
     overlap_tol = _positive("overlap_tol", overlap_tol)
+    if not (isinstance(rounds, (int, np.integer)) and rounds >= 1):
+        raise InputError(f"rounds must be a whole number >= 1, got {rounds!r}")
     poly = _region(width, height, origin, polygon)
     x, r = _fill(x, r, poly, tolerance, rmin, rmax, overlap_tol, not border, rounds)
     return x, r

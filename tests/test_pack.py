@@ -255,6 +255,7 @@ def test_random_pcmm_tolerance_closes_the_element_cover():
     (lambda: pack.fill_holes([[0.5, 0.5]], 0.1, -0.1, 0.1, 0.2, 1.0, 1.0), "tolerance"),
     (lambda: pack.fill_holes([[0.5, 0.5]], 0.1, 0.1, 0.3, 0.2, 1.0, 1.0), "rmax"),
     (lambda: pack.random(2.0, 2.0, 0.1, 0.2, pcmm_tolerance=float("nan")), "pcmm_tolerance"),
+    (lambda: pack.fill_holes([[0.5, 0.5]], 0.1, 0.1, 0.1, 0.2, 1.0, 1.0, rounds=0), "rounds"),
 ])
 def test_fill_holes_bad_input_names_the_argument(call, word):
     with pytest.raises(tdem.InputError, match=word):
