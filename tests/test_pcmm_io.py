@@ -4,10 +4,10 @@ mark, displacement) and FVM blocks (triangles on the current nodes with their
 stress), each against the simulation's own arrays and against what a uniform
 stretch must give (the prescribed displacement, a uniform stress, Hooke's law)."""
 import numpy as np
+from vtk.util.numpy_support import vtk_to_numpy
 
 import tdem
 from test_io import _cell_array, _point_array, _vtk_read
-from vtk.util.numpy_support import vtk_to_numpy
 
 E, NU, RHO = 30e9, 0.25, 2500.0
 VTK_TRIANGLE = 5
