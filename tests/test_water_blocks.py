@@ -15,10 +15,13 @@ reports against measured values, with tolerances:
   rotation at most 1.6°; a 25° floor cannot hold them against the surge, see
   the case docstring, "Result");
 - no block is thrown up: no block's centre rises above its start by more than
-  a block tipping over its corner could raise it, (√2 − 1)/2 × 0.1 m = 2.1 cm,
-  with a margin for blocks riding over each other as they fall (bound 3 cm;
-  measured 0.3 cm and 1.5 cm; an earlier vertex–edge rule threw blocks to
-  1.1 m);
+  riding onto another block and tipping over its corner could raise it, one
+  block height plus (√2 − 1)/2 × 0.1 m, 12 cm (an earlier vertex–edge rule threw
+  blocks to 1.1 m). The two toppling columns pile against the right wall, blocks
+  landing on each other, and how they pile changes from run to run: on 2 threads
+  the point–edge forces are summed by atomic additions, whose order varies, and
+  the toppling amplifies the round-off; four runs of the same code gave the
+  largest rise 1.5, 3.7, 7.4 and 8.9 cm (four columns: 0.3–0.6 cm);
 - the water stays weakly compressible: its fastest particle below c/5 (c =
   122 m/s; measured 8.8 m/s; the runs completed).
 Measured run time: 175-250 s for both runs on 2 shared cores (hence slow).
@@ -69,7 +72,7 @@ def test_outcome(result):
 def test_no_block_thrown_up(result):
     s, _ = result
     for name in ("four", "two"):
-        assert s["figures"][f"{name}_block_rise_max"]["value"] < 0.03, name
+        assert s["figures"][f"{name}_block_rise_max"]["value"] < 0.1 + 0.05 * (2 ** 0.5 - 1), name
 
 
 def test_weakly_compressible(result):
