@@ -101,10 +101,11 @@ its weight).
 Vertex–edge contacts now follow the entrance rule (``coupling.point_edge``):
 a vertex meets only an edge it can have entered through; with it no corner
 meets a side edge of the block below, the blocks' kinetic energy peaks at
-about 60 J (four columns) and no block rises more than 2 cm before the toppled
-blocks pile against the right wall (there, blocks landing on each other rise
-1.5–9 cm, by the run: on 2 threads the point–edge forces are summed by atomic
-additions in a varying order, and the toppling amplifies the round-off). The same blocks
+about 60 J (four columns), where no block rises more than 1 cm; the two toppled
+columns pile up against the right wall, blocks landing on each other, and the
+largest rise there is 1.5–9 cm by the run (on 2 threads the point–edge forces
+are summed by atomic additions in a varying order, and the toppling amplifies
+the round-off). The same blocks
 without water had not shown it: their settled stack was exactly symmetric and
 nothing shifted a corner.
 
