@@ -289,10 +289,7 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     added, and under its own weight its σ_yy at nine points of x = 10 m from up to
     15 % to at most 1.6 % off the elastic solution (``cases/elastic_gravity.py``).
     """
-    rmin = _positive("rmin", rmin)
-    rmax = _positive("rmax", rmax)
-    if rmax < rmin:
-        raise InputError(f"rmax must be >= rmin, got rmin={rmin!r}, rmax={rmax!r}")
+    rmin, rmax = _radius_range(rmin, rmax)
     overlap_tol = _positive("overlap_tol", overlap_tol)
     if pcmm_tolerance is not None:
         pcmm_tolerance = _nonnegative("pcmm_tolerance", pcmm_tolerance)
@@ -396,6 +393,14 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
                      f"overlap_tol")
 
 
+def _radius_range(rmin, rmax):
+    rmin = _positive("rmin", rmin)
+    rmax = _positive("rmax", rmax)
+    if rmax < rmin:
+        raise InputError(f"rmax must be >= rmin, got rmin={rmin!r}, rmax={rmax!r}")
+    return rmin, rmax
+
+
 def fill_holes(positions, radii, tolerance, rmin, rmax, width=None, height=None,
                origin=(0.0, 0.0), polygon=None, overlap_tol=0.7, border=False, rounds=5):
     """Discs added into the holes of the PCMM element cover of a packing.
@@ -425,10 +430,7 @@ def fill_holes(positions, radii, tolerance, rmin, rmax, width=None, height=None,
     if r.shape not in ((), (len(x),)):
         raise InputError(f"radii must be a number or {len(x)} numbers, got shape {r.shape}")
     r = np.broadcast_to(r, (len(x),)).copy()
-    rmin = _positive("rmin", rmin)
-    rmax = _positive("rmax", rmax)
-    if rmax < rmin:
-        raise InputError(f"rmax must be >= rmin, got rmin={rmin!r}, rmax={rmax!r}")
+    rmin, rmax = _radius_range(rmin, rmax)
     tolerance = _nonnegative("tolerance", tolerance)
     overlap_tol = _positive("overlap_tol", overlap_tol)
     if not (isinstance(rounds, (int, np.integer)) and rounds >= 1):
