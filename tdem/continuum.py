@@ -37,9 +37,42 @@ MAX_CANDIDATES = 1024
 RIGID_NODE = 8          # node flag: the node belongs to a free rigid block
 
 # arrays copied into the run segment's snapshot (the dynamic state)
-_SNAP = ("psig", "peps", "pstate", "pjwl", "xforce", "cand", "ccnt", "pflags", "elem", "ecnt", "esig",
-         "npos", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
-         "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")
+# the restore point of a run segment: the per-particle arrays below are copied by one
+# kernel (:func:`copy_particles`, in this order), the others one by one
+_SNAP_PARTICLES = ("psig", "peps", "pstate", "pjwl", "xforce", "ccnt", "ecnt", "cand", "elem",
+                   "esig")
+_SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig", "tstate",
+                           "nflags", "psedge", "psforce", "psbroken", "vsedge", "vsforce",
+                           "vsbroken", "rstate")
+
+
+@cached
+@ti.kernel
+def copy_particles(a0: ti.types.ndarray(), a1: ti.types.ndarray(), a2: ti.types.ndarray(),
+                   a3: ti.types.ndarray(), a4: ti.types.ndarray(), a5: ti.types.ndarray(),
+                   a6: ti.types.ndarray(), a7: ti.types.ndarray(), a8: ti.types.ndarray(),
+                   a9: ti.types.ndarray(), b0: ti.types.ndarray(), b1: ti.types.ndarray(),
+                   b2: ti.types.ndarray(), b3: ti.types.ndarray(), b4: ti.types.ndarray(),
+                   b5: ti.types.ndarray(), b6: ti.types.ndarray(), b7: ti.types.ndarray(),
+                   b8: ti.types.ndarray(), b9: ti.types.ndarray(), serial: ti.template()):
+    """Copy the arrays of ``_SNAP_PARTICLES`` (a*) into b*, one parallel loop over the
+    particles (Taichi's generic ``copy_from`` indexes a 3-d array element by element,
+    several times slower on the element slots)."""
+    ti.loop_config(serialize=serial)
+    for i in range(a0.shape[0]):
+        b0[i] = a0[i]
+        b1[i] = a1[i]
+        b2[i] = a2[i]
+        b3[i] = a3[i]
+        b4[i] = a4[i]
+        b5[i] = a5[i]
+        b6[i] = a6[i]
+        for k in range(a7.shape[1]):
+            b7[i, k] = a7[i, k]
+        for s in range(a8.shape[1]):
+            b8[i, s, 0] = a8[i, s, 0]
+            b8[i, s, 1] = a8[i, s, 1]
+            b9[i, s] = a9[i, s]
 
 
 @cached
@@ -672,14 +705,25 @@ class Continuum:
                 dst = self.snap[k] = (ti.Vector.ndarray(src.n, src.dtype, tuple(src.shape))
                                       if hasattr(src, "n") else
                                       ti.ndarray(src.dtype, tuple(src.shape)))
-            dst.copy_from(src)
+            if k not in _SNAP_PARTICLES:
+                dst.copy_from(src)
+        serial = backend.serial_loops(self.n, True)
+        copy_particles(*[self.a[k] for k in _SNAP_PARTICLES],
+                       *[self.snap[k] for k in _SNAP_PARTICLES], serial)
 
     def restore_snapshot(self):
+        whole = all(self.snap.get(k) is not None and
+                    tuple(self.snap[k].shape) == tuple(self.a[k].shape) for k in _SNAP_PARTICLES)
         for k in _SNAP:
             dst = self.a[k]
             src = self.snap.get(k)
-            if src is not None and tuple(src.shape) == tuple(dst.shape):
+            if src is not None and tuple(src.shape) == tuple(dst.shape) and not (
+                    whole and k in _SNAP_PARTICLES):
                 dst.copy_from(src)
+        if whole:
+            serial = backend.serial_loops(self.n, True)
+            copy_particles(*[self.snap[k] for k in _SNAP_PARTICLES],
+                           *[self.a[k] for k in _SNAP_PARTICLES], serial)
         if self.snap.get("cand") is None:
             self.a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
         # the map of copies belongs to the elements before the restore: every restored

@@ -227,6 +227,32 @@ def test_momentum_conserved_while_elements_die_and_are_born():
     assert np.abs(p1 - p0).max() < 1e-10 * scale
 
 
+def test_candidate_slots_grow_and_steps_are_redone():
+    """The PCMM candidate lists start too short (2 slots): the segment is restored from
+    its snapshot, the lists grow and the steps are redone; positions, element stresses
+    and particle stresses equal those of a run that started with enough slots."""
+    def run(cap):
+        sim, _ = _soft_body()
+        sim.check_interval = 40
+        sim._build()
+        if cap is not None:
+            sim._cont.capacity = cap
+            sim._cont._alloc_lists()
+        sim.run(steps=120)
+        return sim
+
+    small, ref = run(2), run(None)
+    assert small._cont.capacity > 2
+    a, b = small.particles.numpy(), ref.particles.numpy()
+    np.testing.assert_allclose(a["position"], b["position"], rtol=0, atol=1e-12)
+    scale = np.abs(b["stress"]).max()
+    assert scale > 0
+    np.testing.assert_allclose(a["stress"], b["stress"], rtol=0, atol=1e-9 * scale)
+    ea, eb = small.elements.numpy(), ref.elements.numpy()
+    assert len(ea["triangles"]) == len(eb["triangles"]) > 100
+    np.testing.assert_allclose(ea["stress"], eb["stress"], rtol=0, atol=1e-9 * scale)
+
+
 def test_bodies_that_share_no_element_collide_through_the_contact_law():
     """Two PCMM blocks of different materials meet head on: no elements join them,
     the contact law stops them from passing through each other, momentum holds."""
