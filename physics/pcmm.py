@@ -947,24 +947,24 @@ def displacements(pos: ti.types.ndarray(), pmat: ti.types.ndarray(),
 
 
 @ti.func
-def _stress_of(i, s, esig: ti.template(), emult: ti.template(), ecopy: ti.template()):
-    """Last step's stress of the element in i's slot s: its own when it is the
-    computed copy, else the computed copy's (``ecopy``; copies' own ``esig`` is kept
-    only where it is read, see :func:`copies`)."""
-    out = esig[i, s]
+def _stress_of(i, s, sig: ti.template(), eidx: ti.template(), esig: ti.template(),
+               emult: ti.template(), ecopy: ti.template()):
+    """The stress of the element in i's slot s by the map of the stress pass that
+    wrote ``sig`` (``emult``, ``ecopy``, ``eidx`` as that pass left them): the
+    computed copy's (i's slot itself, or the slot ``ecopy`` names), which lies in
+    ``sig`` at the record index ``eidx`` of that slot; ``esig`` where that index is
+    −1 (see :func:`copies`)."""
+    o, so = i, s
     if emult[i, s] == 0:
         code = ecopy[i, s]
-        out = esig[code >> 4, code & 15]
+        o, so = code >> 4, code & 15
+    j = eidx[o, so]
+    out = ti.Vector([0.0, 0.0, 0.0, 0.0])
+    if j >= 0:
+        out = sig[j]
+    else:
+        out = esig[o, so]
     return out
-
-
-@ti.func
-def _refresh_copies(a, ecnt: ti.template(), emult: ti.template(), ecopy: ti.template(),
-                    esig: ti.template()):
-    """The stresses of a's copies from their computed copies (last step's map)."""
-    for s in range(ecnt[a]):
-        if emult[a, s] == 0:
-            esig[a, s] = _stress_of(a, s, esig, emult, ecopy)
 
 
 @cached
@@ -976,6 +976,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                      ring: ti.types.ndarray(), rang: ti.types.ndarray(),
                      elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
                      earea: ti.types.ndarray(), esig: ti.types.ndarray(),
+                     sigp: ti.types.ndarray(), eidx: ti.types.ndarray(),
                      elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
                      ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(),
                      emult: ti.types.ndarray(), ecopy: ti.types.ndarray(),
@@ -995,9 +996,9 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
     and elements came out as they were, the usual case of a particle near one of
     the rules' thresholds, else ``REBUILT_CHANGED``). A rebuilt particle keeps its last
     elements and their stresses in the ``_old`` arrays and points each new slot at
-    the old slot of the same element (``esrc``, −1 for a new one); the stress of a
-    copy is read from its computed copy (``emult``, ``ecopy`` of last step, see
-    :func:`copies`; nothing writes ``esig`` here).
+    the old slot of the same element (``esrc``, −1 for a new one); the stresses
+    come from last step's stress pass (``sigp``, :func:`_stress_of`; nothing writes
+    ``esig`` or ``eidx`` here).
     """
     new = pflags[P_NEW] != 0
     built = pflags[P_BUILT] != 0
@@ -1058,7 +1059,7 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                 for s in range(ecnt[i]):
                     elem_old[i, s, 0] = elem[i, s, 0]
                     elem_old[i, s, 1] = elem[i, s, 1]
-                    esig_old[i, s] = _stress_of(i, s, esig, emult, ecopy)
+                    esig_old[i, s] = _stress_of(i, s, sigp, eidx, esig, emult, ecopy)
                 r, rs = _ring(i, xi, cnt, pos, nbr, ring, rang)
                 ne, cs = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
                 ecnt[i] = ne
@@ -1120,26 +1121,35 @@ def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types
 @ti.kernel
 def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
            emult: ti.types.ndarray(), ecopy: ti.types.ndarray(), pdirty: ti.types.ndarray(),
-           prb: ti.types.ndarray(), esig: ti.types.ndarray(), serial: ti.template()):
+           prb: ti.types.ndarray(), esig: ti.types.ndarray(), sigp: ti.types.ndarray(),
+           eidx: ti.types.ndarray(), serial: ti.template()):
     """1b. Copies: a triangle created by k of its vertices is computed once, by the
     copy of the lowest-index creator, with multiplicity k (``emult``; 0 for the other
     copies, whose ``ecopy`` = owner << 4 | slot of the computed copy). Copies have the
     same N_e, stress and forces, so every sum over elements weights the computed copy
     by k. Only where something changed (``pdirty``).
 
-    A copy's own ``esig`` is brought up to date only where it can be read: here,
-    from last step's map and before the map changes, in the particles that kept
-    their elements but whose map can change (dirty ones; the stress pass reads a
-    copy's stress only there: a slot that becomes the computed copy, and the
-    neighbours of a rebuilt particle in :func:`_carried`); by
-    :func:`rebuild_elements` for a rebuilt particle's old slots; by
-    :func:`sync_copies` before the host reads them. The computed copies read here
-    are not written in this kernel."""
+    Where the stresses are: the stress pass writes those of the computed copies in
+    record order (``sigc``, index ``eidx`` of the slot; last step's are ``sigp``),
+    so that it reads and writes them in sequence. ``esig`` (per slot) is brought up
+    to date only where it is read: here, by last step's map and before the map
+    changes, for every slot of the particles that kept their elements but whose map
+    can change (dirty ones), whose ``eidx`` then becomes −1 (the stress pass reads
+    ``esig`` there: a slot that becomes the computed copy, and the neighbours of a
+    rebuilt particle in :func:`_carried`); by :func:`rebuild_elements` for a
+    rebuilt particle's old slots (``esig_old``); by :func:`sync_copies` for all,
+    before the host reads or saves them. The first loop reads the map, the second
+    changes it."""
+    ti.loop_config(serialize=serial)
+    for a in range(pmat.shape[0]):
+        if pdirty[a] != 0 and prb[a] == 0:
+            for s in range(ecnt[a]):
+                esig[a, s] = _stress_of(a, s, sigp, eidx, esig, emult, ecopy)
     ti.loop_config(serialize=serial)
     for a in range(pmat.shape[0]):
         if pdirty[a] != 0:
-            if prb[a] == 0:
-                _refresh_copies(a, ecnt, emult, ecopy, esig)
+            for s in range(ecnt[a]):
+                eidx[a, s] = -1
             for s in range(ecnt[a]):
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
@@ -1164,11 +1174,13 @@ def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.nd
 
 @ti.kernel
 def sync_copies(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(), ecopy: ti.types.ndarray(),
-                esig: ti.types.ndarray()):
-    """Every copy's ``esig`` from its computed copy (before the host reads or saves
-    the element stresses; see :func:`copies`)."""
+                esig: ti.types.ndarray(), sigc: ti.types.ndarray(), eidx: ti.types.ndarray()):
+    """Every slot's ``esig`` from the last stress pass (before the host reads or saves
+    the element stresses; see :func:`copies`). A slot whose ``eidx`` is −1 keeps its
+    own, and the slots read are not written: one loop."""
     for a in range(ecnt.shape[0]):
-        _refresh_copies(a, ecnt, emult, ecopy, esig)
+        for s in range(ecnt[a]):
+            esig[a, s] = _stress_of(a, s, sigc, eidx, esig, emult, ecopy)
 
 
 @cached
@@ -1317,18 +1329,22 @@ def _corner_force(k, o, j, r, pos: ti.template(), efor: ti.template()):
 
 
 @ti.func
-def _carried(a, b, c, s, elem: ti.template(), ecnt: ti.template(), esig: ti.template(),
-             elem_old: ti.template(), esig_old: ti.template(), ecnt_old: ti.template(),
-             esrc: ti.template(), prb: ti.template()):
+def _carried(a, b, c, s, jold, elem: ti.template(), ecnt: ti.template(), esig: ti.template(),
+             sigp: ti.template(), elem_old: ti.template(), esig_old: ti.template(),
+             ecnt_old: ti.template(), esrc: ti.template(), prb: ti.template()):
     """Last step's stress of the element (a, b, c) in a's slot s, if it existed: a's
-    own slot when a kept its elements, else the old slot ``esrc`` points at, else the
-    copy of b or c (their old lists when they rebuilt; a copy not computed this step
-    is not written by the stress pass, so reading it is safe). Returns (stress,
-    found)."""
+    own slot when a kept its elements (at last step's record index ``jold`` of the
+    slot, or in ``esig`` where that is −1, see :func:`copies`), else the old slot
+    ``esrc`` points at, else the copy of b or c (their old lists when they rebuilt;
+    otherwise ``esig``, brought up to date there because they are dirty, and not
+    written by the stress pass). Returns (stress, found)."""
     out = ti.Vector([0.0, 0.0, 0.0, 0.0])
     found = False
     if prb[a] == 0:
-        out = esig[a, s]
+        if jold >= 0:
+            out = sigp[jold]
+        else:
+            out = esig[a, s]
         found = True
     elif esrc[a, s] >= 0:
         out = esig_old[a, esrc[a, s]]
@@ -1358,6 +1374,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
              matp: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
              emult: ti.types.ndarray(), inc: ti.types.ndarray(), icnt: ti.types.ndarray(),
              ncov: ti.types.ndarray(), ebud: ti.types.ndarray(), esig: ti.types.ndarray(),
+             sigp: ti.types.ndarray(), sigc: ti.types.ndarray(),
              efor: ti.types.ndarray(), ede: ti.types.ndarray(), psig: ti.types.ndarray(),
              pfail: ti.types.ndarray(), rad: ti.types.ndarray(),
              elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
@@ -1373,7 +1390,8 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     the mid-step configuration, see :mod:`physics.blocks`), the constitutive
     correction (Eq. 12), and the record from which the gather makes the nodal
     forces with the weight 1/N_e (Eqs. 13–14, sign fixed; :func:`_record`), in the
-    next place of the particle's run of records (``eidx``, :func:`record_slots`)."""
+    next place of the particle's run of records (``eidx``, :func:`record_slots`);
+    the stress at the same place of ``sigc`` (:func:`copies`)."""
     new = pflags[P_NEW] != 0
     soft = pflags[P_SOFT] != 0
     ti.loop_config(serialize=serial)
@@ -1381,6 +1399,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
         j = ebase[a]
         for s in range(ecnt[a]):
             if emult[a, s] > 0:
+                jold = eidx[a, s]
                 eidx[a, s] = j
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
@@ -1416,8 +1435,8 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     # particles carry the equation of state, see the gather below)
                     found = False
                     if ti.static(carry):
-                        sig, found = _carried(a, b, c, s, elem, ecnt, esig, elem_old,
-                                              esig_old, ecnt_old, esrc, prb)
+                        sig, found = _carried(a, b, c, s, jold, elem, ecnt, esig, sigp,
+                                              elem_old, esig_old, ecnt_old, esrc, prb)
                     if not found:
                         sig = (psig[a] + psig[b] + psig[c]) / 3.0
                     sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
@@ -1426,7 +1445,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     if pfail[a] + pfail[b] + pfail[c] > 0:
                         failed = 1
                     sig, eps, flag = mc_correct_state(sig, matp, M, failed)
-                esig[a, s] = sig
+                sigc[j] = sig
                 _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp, emult,
                         efor, ede, dt, eos)
                 j += 1
@@ -1471,7 +1490,7 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                       elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
                       emult: ti.types.ndarray(), inc: ti.types.ndarray(),
                       icnt: ti.types.ndarray(), ncov: ti.types.ndarray(),
-                      esig: ti.types.ndarray(), efor: ti.types.ndarray(),
+                      sigc: ti.types.ndarray(), efor: ti.types.ndarray(),
                       eidx: ti.types.ndarray(),
                       ede: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
                       time: ti.f64, serial: ti.template()):
@@ -1523,7 +1542,7 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                     c = elem[a, s, 1]
                     pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
                     sig = ti.Vector([-pm, -pm, 0.0, -pm])
-                    esig[a, s] = sig
+                    sigc[eidx[a, s]] = sig
                     d = ede[a, s]
                     de = ti.Vector([d[0], d[1], d[2]])
                     q = 0.0
@@ -1669,27 +1688,30 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     pstate[i] = (plastic shear strain, failed (0/1), elements containing i, −).
     """
     full = int(bool(full) or bool(first))
+    a["sigp"], a["sigc"] = a["sigc"], a["sigp"]       # last step's stresses, this step's
     displacements(e["pos"], a["pmat"], a["xref"], a["pu"], a["pflags"], full, serial)
     rebuild_elements(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
                      a["nbr"], a["ncnt"], a["ring"], a["rang"], a["elem"], a["ecnt"],
-                     a["earea"], a["esig"], a["elem_old"], a["esig_old"], a["ecnt_old"],
+                     a["earea"], a["esig"], a["sigp"], a["eidx"], a["elem_old"], a["esig_old"],
+                     a["ecnt_old"],
                      a["esrc"], a["emult"], a["ecopy"], a["pu"], a["pbud"], a["prb"],
                      a["pflags"], serial)
     mark_dirty(a["pmat"], a["nbr"], a["ncnt"], a["pu"], a["prb"], a["pdirty"], a["unb"],
                a["pstate"], a["pfail"], e["pos"], a["xref"], a["pflags"], serial)
     copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], a["prb"],
-           a["esig"], serial)
+           a["esig"], a["sigp"], a["eidx"], serial)
     incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
               a["picnt"], a["piwt"], a["pdirty"], a["pflags"], serial)
     record_slots(a["ecnt"], a["emult"], a["ebase"], a["eoff"], serial)
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
-             a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["efor"], a["ede"],
+             a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["sigp"], a["sigc"],
+             a["efor"], a["ede"],
              a["psig"], a["pfail"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
              a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], a["ebase"],
              a["eidx"], dt, carry, eos, serial)
     if eos:
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
-                          a["emult"], a["pinc"], a["picnt"], a["ncov"], a["esig"],
+                          a["emult"], a["pinc"], a["picnt"], a["ncov"], a["sigc"],
                           a["efor"], a["eidx"], a["ede"], a["pjwl"], dt, time, serial)
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
            a["pinc"], a["picnt"], a["piwt"], a["efor"], a["eidx"], a["psig"], a["peps"],

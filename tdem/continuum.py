@@ -245,6 +245,11 @@ class Continuum:
         a["ebase"] = ti.ndarray(ti.i32, (n,))
         a["eoff"] = ti.ndarray(ti.i32, (n // pcmm.SCAN_BLOCK + 2,))
         a["eidx"] = ti.ndarray(ti.i32, (n, E))
+        a["eidx"].fill(-1)     # no stress pass yet: every slot's stress is in esig
+        # the stresses of the computed elements in record order, this step's and last
+        # step's (physics.pcmm.copies)
+        a["sigc"] = _arr(4, (n * E,))
+        a["sigp"] = _arr(4, (n * E,))
         a["ede"] = _arr(7, (n, E))
         a["psig"] = _arr(4, (n,))
         a["peps"] = _arr(3, (n,))
@@ -694,7 +699,8 @@ class Continuum:
         """Bring every copy's element stress up to date (kept lazily on the device,
         see :func:`physics.pcmm.copies`), before the element stresses are saved."""
         if self.has_pcmm:
-            pcmm.sync_copies(self.a["ecnt"], self.a["emult"], self.a["ecopy"], self.a["esig"])
+            pcmm.sync_copies(self.a["ecnt"], self.a["emult"], self.a["ecopy"], self.a["esig"],
+                             self.a["sigc"], self.a["eidx"])
 
     def take_snapshot(self):
         self.sync_copies()
@@ -729,6 +735,7 @@ class Continuum:
         # the map of copies belongs to the elements before the restore: every restored
         # slot holds its own (synced) stress until the next step maps them again
         self.a["emult"].fill(1)
+        self.a["eidx"].fill(-1)
         self._full = True
 
     # ------------------------------------------------------------------ reading
@@ -736,6 +743,7 @@ class Continuum:
         """PCMM elements now (copies included): triangles (E, 3), owner, area, n_cover,
         weight (1/N_e), stress (E, 2, 2), stress_zz (E,)."""
         a = self.a
+        self.sync_copies()
         ecnt = a["ecnt"].to_numpy()
         owner = np.repeat(np.arange(self.n), ecnt)
         slot = np.arange(len(owner)) - np.repeat(np.cumsum(ecnt) - ecnt, ecnt)
