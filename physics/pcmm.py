@@ -1122,7 +1122,7 @@ def mark_dirty(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types
 def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
            emult: ti.types.ndarray(), ecopy: ti.types.ndarray(), pdirty: ti.types.ndarray(),
            prb: ti.types.ndarray(), esig: ti.types.ndarray(), sigp: ti.types.ndarray(),
-           eidx: ti.types.ndarray(), serial: ti.template()):
+           eidx: ti.types.ndarray(), ecomp: ti.types.ndarray(), serial: ti.template()):
     """1b. Copies: a triangle created by k of its vertices is computed once, by the
     copy of the lowest-index creator, with multiplicity k (``emult``; 0 for the other
     copies, whose ``ecopy`` = owner << 4 | slot of the computed copy). Copies have the
@@ -1139,7 +1139,8 @@ def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.nd
     rebuilt particle in :func:`_carried`); by :func:`rebuild_elements` for a
     rebuilt particle's old slots (``esig_old``); by :func:`sync_copies` for all,
     before the host reads or saves them. The first loop reads the map, the second
-    changes it."""
+    changes it and counts each particle's computed elements (``ecomp``, for
+    :func:`record_slots`)."""
     ti.loop_config(serialize=serial)
     for a in range(pmat.shape[0]):
         if pdirty[a] != 0 and prb[a] == 0:
@@ -1150,6 +1151,7 @@ def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.nd
         if pdirty[a] != 0:
             for s in range(ecnt[a]):
                 eidx[a, s] = -1
+            k_comp = 0
             for s in range(ecnt[a]):
                 b = elem[a, s, 0]
                 c = elem[a, s, 1]
@@ -1169,7 +1171,10 @@ def copies(pmat: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.nd
                         owner = c
                         slot = sc
                 emult[a, s] = mult if owner == a else 0
+                if owner == a:
+                    k_comp += 1
                 ecopy[a, s] = (owner << 4) | slot
+            ecomp[a] = k_comp
 
 
 @ti.kernel
@@ -1185,8 +1190,8 @@ def sync_copies(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(), ecopy: ti.t
 
 @cached
 @ti.kernel
-def record_slots(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(),
-                 ebase: ti.types.ndarray(), eoff: ti.types.ndarray(), serial: ti.template()):
+def record_slots(ecomp: ti.types.ndarray(), ebase: ti.types.ndarray(),
+                 eoff: ti.types.ndarray(), serial: ti.template()):
     """1d. Where the records of the computed elements go (:func:`_record`): one run
     per particle, in particle order, the run of particle a from ``ebase[a]`` on, in
     slot order (the stress pass writes each slot's place to ``eidx``). The gather
@@ -1194,24 +1199,16 @@ def record_slots(ecnt: ti.types.ndarray(), emult: ti.types.ndarray(),
     together in memory for neighbouring particles, instead of one fixed-capacity
     block per particle with the used slots scattered in it (the gather then takes
     about half the time on a random packing). ``ebase`` is the exclusive prefix sum
-    of the particles' counts of computed elements, made by blocks of SCAN_BLOCK
-    particles (``eoff``: the blocks' offsets)."""
-    n = ecnt.shape[0]
+    of the particles' counts of computed elements (``ecomp``, see :func:`copies`),
+    made by blocks of SCAN_BLOCK particles (``eoff``: the blocks' offsets)."""
+    n = ecomp.shape[0]
     nb = (n + SCAN_BLOCK - 1) // SCAN_BLOCK
-    ti.loop_config(serialize=serial)
-    for a in range(n):
-        k = 0
-        for s in range(ecnt[a]):
-            if emult[a, s] > 0:
-                k += 1
-        ebase[a] = k
     ti.loop_config(serialize=serial)
     for blk in range(nb):
         run = 0
         for a in range(blk * SCAN_BLOCK, ti.min((blk + 1) * SCAN_BLOCK, n)):
-            k = ebase[a]
             ebase[a] = run
-            run += k
+            run += ecomp[a]
         eoff[blk + 1] = run
     ti.loop_config(serialize=True)
     for _ in range(1):
@@ -1699,10 +1696,10 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     mark_dirty(a["pmat"], a["nbr"], a["ncnt"], a["pu"], a["prb"], a["pdirty"], a["unb"],
                a["pstate"], a["pfail"], e["pos"], a["xref"], a["pflags"], serial)
     copies(a["pmat"], a["elem"], a["ecnt"], a["emult"], a["ecopy"], a["pdirty"], a["prb"],
-           a["esig"], a["sigp"], a["eidx"], serial)
+           a["esig"], a["sigp"], a["eidx"], a["ecomp"], serial)
     incidence(a["pmat"], a["nbr"], a["ncnt"], a["elem"], a["ecnt"], a["emult"], a["pinc"],
               a["picnt"], a["piwt"], a["pdirty"], a["pflags"], serial)
-    record_slots(a["ecnt"], a["emult"], a["ebase"], a["eoff"], serial)
+    record_slots(a["ecomp"], a["ebase"], a["eoff"], serial)
     stresses(e["pos"], e["vel"], a["pmat"], a["matp"], a["elem"], a["ecnt"], a["emult"],
              a["pinc"], a["picnt"], a["ncov"], a["ebud"], a["esig"], a["sigp"], a["sigc"],
              a["efor"], a["ede"],

@@ -243,6 +243,8 @@ class Continuum:
         a["esig"] = _arr(4, (n, E))
         a["efor"] = _arr(8, (2 * n * E,))     # records, packed (pcmm.record_slots)
         a["ebase"] = ti.ndarray(ti.i32, (n,))
+        a["ecomp"] = ti.ndarray(ti.i32, (n,))     # computed elements per particle
+        a["ecomp"].fill(0)
         a["eoff"] = ti.ndarray(ti.i32, (n // pcmm.SCAN_BLOCK + 2,))
         a["eidx"] = ti.ndarray(ti.i32, (n, E))
         a["eidx"].fill(-1)     # no stress pass yet: every slot's stress is in esig

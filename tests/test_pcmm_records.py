@@ -15,20 +15,41 @@ from physics import pcmm
 def test_record_runs_are_the_prefix_sum_of_computed_elements(n, serial):
     import taichi as ti
     backend.init()
-    E = pcmm.MAX_ELEMENTS
     rng = np.random.default_rng(n)
-    ecnt = rng.integers(0, E + 1, n).astype(np.int32)
-    emult = rng.integers(0, 3, (n, E)).astype(np.int32)     # 0: a copy, not computed
-    arrays = {"ecnt": (n,), "emult": (n, E), "ebase": (n,),
-              "eoff": (n // pcmm.SCAN_BLOCK + 2,)}
+    ecomp = rng.integers(0, pcmm.MAX_ELEMENTS + 1, n).astype(np.int32)
+    arrays = {"ecomp": (n,), "ebase": (n,), "eoff": (n // pcmm.SCAN_BLOCK + 2,)}
     a = {k: ti.ndarray(ti.i32, shape) for k, shape in arrays.items()}
-    a["ecnt"].from_numpy(ecnt)
-    a["emult"].from_numpy(emult)
+    a["ecomp"].from_numpy(ecomp)
     a["ebase"].fill(-7)
-    pcmm.record_slots(a["ecnt"], a["emult"], a["ebase"], a["eoff"], serial)
-    computed = (emult > 0) & (np.arange(E)[None, :] < ecnt[:, None])
-    runs = computed.sum(axis=1)
-    np.testing.assert_array_equal(a["ebase"].to_numpy(), np.cumsum(runs) - runs)
+    pcmm.record_slots(a["ecomp"], a["ebase"], a["eoff"], serial)
+    np.testing.assert_array_equal(a["ebase"].to_numpy(), np.cumsum(ecomp) - ecomp)
+
+
+def test_computed_counts_follow_the_elements_through_deaths_and_births():
+    """``ecomp``, kept by the copies pass only where something changed, is each
+    particle's count of computed elements at every check of a body whose elements
+    die and are born (and the records' runs its prefix sum)."""
+    pos, rad = tdem.pack.random(0.3, 0.3, 0.008, 0.012, seed=2, target_fraction=0.72)
+    rng = np.random.default_rng(2)
+    vel = rng.normal(0.0, 0.3, pos.shape) - 8.0 * (pos - pos.mean(axis=0))
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.3, progress=False)
+    sim.add_particles(pos, rad, material=tdem.Elastic(density=1000.0, young=2e4, poisson=0.25),
+                      tolerance=0.012, velocity=vel,
+                      contact=tdem.LinearContact(kn=2e4, ks=2e4, friction=0.3))
+    changed = 0
+    prev = None
+    for _ in range(8):
+        sim.run(steps=40)
+        a = sim._cont.a
+        ecnt, emult = a["ecnt"].to_numpy(), a["emult"].to_numpy()
+        want = ((emult > 0) & (np.arange(emult.shape[1])[None, :] < ecnt[:, None])).sum(axis=1)
+        np.testing.assert_array_equal(a["ecomp"].to_numpy(), want)
+        np.testing.assert_array_equal(a["ebase"].to_numpy(), np.cumsum(want) - want)
+        tri = {tuple(sorted(t)) for t in sim.elements.numpy()["triangles"]}
+        if prev is not None:
+            changed += len(tri ^ prev)
+        prev = tri
+    assert changed > 50
 
 
 def _ringing_square(order):
