@@ -36,9 +36,8 @@ from .step import FIX_VX, FIX_VY, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY
 MAX_CANDIDATES = 1024
 RIGID_NODE = 8          # node flag: the node belongs to a free rigid block
 
-# arrays copied into the run segment's snapshot (the dynamic state)
-# the restore point of a run segment: the per-particle arrays below are copied by one
-# kernel (:func:`copy_particles`, in this order), the others one by one
+# the restore point of a run segment (the dynamic state): the per-particle arrays
+# below are copied by one kernel (:func:`copy_particles`, in this order), the others one by one
 _SNAP_PARTICLES = ("psig", "peps", "pstate", "pjwl", "xforce", "ccnt", "ecnt", "cand", "elem",
                    "esig")
 _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig", "tstate",
@@ -698,8 +697,9 @@ class Continuum:
         self.snap.pop("cand", None)
 
     def sync_copies(self):
-        """Bring every copy's element stress up to date (kept lazily on the device,
-        see :func:`physics.pcmm.copies`), before the element stresses are saved."""
+        """Bring every slot's element stress (``esig``) up to date from the last stress
+        pass (kept lazily on the device, see :func:`physics.pcmm.copies`), before the
+        element stresses are read or saved."""
         if self.has_pcmm:
             pcmm.sync_copies(self.a["ecnt"], self.a["emult"], self.a["ecopy"], self.a["esig"],
                              self.a["sigc"], self.a["eidx"])
