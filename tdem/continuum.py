@@ -37,7 +37,8 @@ MAX_CANDIDATES = 1024
 RIGID_NODE = 8          # node flag: the node belongs to a free rigid block
 
 # the restore point of a run segment (the dynamic state): the per-particle arrays
-# below are copied by one kernel (:func:`copy_particles`, in this order), the others one by one
+# below are copied by one kernel (:func:`copy_particles`, in this order), the others
+# one by one
 _SNAP_PARTICLES = ("psig", "peps", "pstate", "pjwl", "xforce", "ccnt", "ecnt", "cand", "elem",
                    "esig")
 _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig", "tstate",
