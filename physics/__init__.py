@@ -3,9 +3,9 @@
 One law per file; each file holds the user-facing parameter class and the Taichi
 function the engine calls for one contact.
 """
-from .contact_law import ContactLaw
+from .contact_law import ContactLaw, register_law
 from .linear import LinearContact
 from .hertz_mindlin import HertzMindlin
 from .rolling import RollingResistance
 
-__all__ = ["ContactLaw", "LinearContact", "HertzMindlin", "RollingResistance"]
+__all__ = ["ContactLaw", "register_law", "LinearContact", "HertzMindlin", "RollingResistance"]

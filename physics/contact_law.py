@@ -1,20 +1,54 @@
-"""The contact-law table shared by all laws, and the dispatch for one contact.
+"""Contact laws: the base class, the registry, and the dispatch for one contact.
 
-Every law is packed into one row of floats so that the engine's kernels can read
-any law from one array. Columns:
+A contact is computed in three parts (Yade's geometry → physics → law functors):
+the engine's geometry function of the shape pair (:mod:`tdem.step`) gives the overlap
+``u``, the normal and the relative velocity; the contact law turns them and the law's
+own history columns into forces, a tangent stiffness and the dissipated energy; the
+engine adds rolling resistance (:mod:`physics.rolling`) and accumulates the forces.
+
+A law is a subclass of :class:`ContactLaw` in a file of its own (the built-in ones:
+:mod:`physics.linear`, :mod:`physics.hertz_mindlin`), registered once with
+:func:`register_law`. It declares
+
+- ``params``: the names of its parameter columns, in order; :meth:`ContactLaw.values`
+  gives their numbers (by default the attributes of those names);
+- ``history``: the names of its history columns (kept per contact, carried across
+  neighbour rebuilds, snapshots and checkpoints); the first is by convention the
+  tangential spring force that the energy account and output read;
+- ``force``, ``energy`` and ``stiffness``: Taichi functions (``@staticmethod`` + ``@ti.func``)::
+
+      force(q, u, vn, vs, meff, reff, dt, h) -> (fn_el, fn, fs, kn, cn, diss, h)
+      energy(q, u, reff, h) -> stored elastic energy (normal and tangential springs)
+      stiffness(q, u, reff) -> tangent normal stiffness k_n (for the rolling spring)
+
+  with ``q`` the vector of the parameters in ``params`` order, ``u`` > 0 the overlap,
+  ``vn``, ``vs`` the relative velocity of the partner along the normal and the
+  tangent, ``meff`` the effective mass m* (m_i against a wall), ``reff`` the
+  effective radius R* (R_i against a wall), ``h`` the contact's history vector (the
+  law's columns are ``h[0] … h[len(history) − 1]``; it returns it updated). It
+  returns the elastic normal force ``fn_el`` and the total ``fn`` (both
+  compression-positive), the total tangential force ``fs``, the tangent normal
+  stiffness ``kn`` and normal dashpot ``cn`` (rolling resistance and the critical
+  time step use them) and the energy dissipated in the step.
+
+A law defined in a user's script is registered and used exactly like a built-in one
+(no edit of the package); kernels compiled before a registration are recompiled for
+simulations built after it.
+
+The parameter table (one row per law used by a simulation, ``lawp``) has the columns
 
 ====  ==========================================================
-0     law type: 0 linear (Cundall & Strack), 1 Hertz–Mindlin
-1     k_n (linear) or E* (Hertz)
-2     k_s (linear) or G* (Hertz)
-3     friction coefficient tan(phi_mu)
-4     cohesion c (force, N) in the Coulomb limit
-5     beta: contact damping c_n = beta k_n, c_s = beta k_s (C&S Eq. 28)
-6     gamma_e = 2 ln(1/e)/sqrt(pi^2 + ln^2 e): c_n = gamma_e sqrt(k_n m*)
-7     rolling resistance delta (B = delta r_bar), 0 = off
-8     rolling model (1 elastic-perfectly plastic, 2 elastic-brittle)
-9     rolling damping on (1) or off (0)
+0     law code (index in the registry)
+1     rolling resistance delta (B = delta r_bar), 0 = off   (:mod:`physics.rolling`)
+2     rolling model (1 elastic-perfectly plastic, 2 elastic-brittle)
+3     rolling damping on (1) or off (0)
+4…    the law's ``params``
 ====  ==========================================================
+
+and each contact slot's history vector holds the law's columns first, then the
+rolling couple, rotation and broken flag (:data:`ROLLING_COLUMNS`), then, for pairs
+of particles, the overlap offset of a pair that left the PCMM elements (``u0``, the
+last column).
 """
 import math
 
@@ -22,25 +56,127 @@ import taichi as ti
 
 from tdem.errors import InputError
 
-from .rolling import RollingResistance
+from .rolling import COL_ROLL_DAMP, COL_ROLL_DELTA, COL_ROLL_MODEL, RollingResistance
 from .validate import non_negative
 
-LAW_WIDTH = 12
-LINEAR, HERTZ = 0, 1
+# columns of a row of the law table (the rolling ones are physics.rolling's)
+COL_CODE = 0
+COL_PARAMS = COL_ROLL_DAMP + 1
+ROLLING_COLUMNS = ("moment", "rotation", "broken")
+
+_REGISTRY = []           # law classes; a class's code is its index
+_BY_NAME = {}
+
+
+def register_law(cls):
+    """Register a contact law class (usable as a decorator); returns it.
+
+    The class must subclass :class:`ContactLaw` and declare ``params``, ``history``,
+    ``force``, ``energy`` and ``stiffness`` (module docstring). Registering the same class again does
+    nothing; another class of a registered name is refused."""
+    if not (isinstance(cls, type) and issubclass(cls, ContactLaw)):
+        raise InputError(f"register_law takes a subclass of tdem.ContactLaw, got {cls!r}")
+    name = cls.__name__
+    known = _BY_NAME.get(name)
+    if known is cls:
+        return cls
+    if known is not None:
+        raise InputError(f"a contact law named {name!r} is registered already ({known!r})")
+    for attr in ("params", "history"):
+        v = getattr(cls, attr, None)
+        if not isinstance(v, tuple) or not all(isinstance(s, str) for s in v):
+            raise InputError(f"{name}.{attr} must be a tuple of column names, got {v!r}")
+    if len(cls.history) < 1:
+        raise InputError(f"{name}.history must name at least the tangential spring column")
+    for attr in ("force", "energy", "stiffness"):
+        if not callable(getattr(cls, attr, None)):
+            raise InputError(f"{name}.{attr} must be a Taichi function (@staticmethod @ti.func)")
+    cls.code = len(_REGISTRY)
+    _REGISTRY.append(cls)
+    _BY_NAME[name] = cls
+    return cls
+
+
+def unregister_law(cls):
+    """Take back the most recent registration, ``cls`` (for tests and notebooks that
+    define a law for a while). Simulations built while it was registered keep it."""
+    if not _REGISTRY or _REGISTRY[-1] is not cls or cls.__module__.startswith("physics."):
+        raise InputError(f"only the most recently registered law can be unregistered, "
+                         f"not {cls!r}")
+    _REGISTRY.pop()
+    del _BY_NAME[cls.__name__]
+
+
+def registered():
+    """The registered law classes now, as a tuple (the kernels' template argument: a
+    simulation keeps the tuple of the time it was built)."""
+    return tuple(_REGISTRY)
+
+
+def is_registered(cls):
+    return _BY_NAME.get(cls.__name__) is cls
+
+
+def law_class(name):
+    """The registered law class of this name."""
+    try:
+        return _BY_NAME[name]
+    except KeyError:
+        raise InputError(f"no contact law named {name!r} is registered (known: "
+                         f"{sorted(_BY_NAME)}); register it with tdem.register_law "
+                         f"before loading") from None
+
+
+def history_width(laws):
+    """Number of history columns the laws of ``laws`` own (the widest)."""
+    return max(len(c.history) for c in laws)
+
+
+def pair_history_width(laws):
+    """Width of a particle pair's history vector: law columns, rolling, u0."""
+    return history_width(laws) + len(ROLLING_COLUMNS) + 1
+
+
+def wall_history_width(laws):
+    """Width of a particle–wall history vector: law columns, rolling."""
+    return history_width(laws) + len(ROLLING_COLUMNS)
+
+
+def table_width(laws):
+    return COL_PARAMS + max(len(c.params) for c in laws)
 
 
 class ContactLaw:
-    """Base class of particle–particle and particle–wall contact laws."""
+    """Base class of particle–particle and particle–wall contact laws (module
+    docstring: what a subclass declares)."""
 
+    params = ()
+    history = ()
     rolling = None
 
-    def row(self):
-        raise NotImplementedError
+    def values(self):
+        """Numbers of the parameter columns, in ``params`` order."""
+        return [float(getattr(self, name)) for name in self.params]
+
+    def row(self, width=None):
+        """This law's row of the parameter table."""
+        cls = type(self)
+        if not is_registered(cls):
+            raise InputError(f"contact law {cls.__name__} is not registered: decorate it "
+                             f"with @tdem.register_law")
+        vals = self.values()
+        if len(vals) != len(cls.params):
+            raise InputError(f"{cls.__name__}.values() gave {len(vals)} numbers for the "
+                             f"{len(cls.params)} params {cls.params}")
+        r = [float(cls.code)] + self._rolling_columns() + vals
+        if width is not None:
+            r += [0.0] * (width - len(r))
+        return r
 
     def critical_stiffness(self, radius, mass):
         """Largest stiffness the law reaches for particles of this radius and mass
         (numbers or numpy arrays), for the critical time step."""
-        raise NotImplementedError
+        raise NotImplementedError(f"{type(self).__name__} must define critical_stiffness")
 
     def update(self, **params):
         """Change parameters, validated as in the constructor (e.g.
@@ -57,7 +193,7 @@ class ContactLaw:
         return self
 
     def _set_common(self, friction, cohesion, restitution, damping_ratio, rolling):
-        """Friction, cohesion and damping shared by every law, validated."""
+        """Friction, cohesion and damping shared by the built-in laws, validated."""
         self.friction = non_negative("friction", friction)
         self.cohesion = non_negative("cohesion", cohesion)
         self.damping_ratio = non_negative("damping_ratio", damping_ratio)
@@ -74,6 +210,9 @@ class ContactLaw:
             if e < 1.0:
                 le = math.log(1.0 / e)
                 self._gamma = 2.0 * le / math.sqrt(math.pi ** 2 + le ** 2)
+        self._set_rolling(rolling)
+
+    def _set_rolling(self, rolling):
         if rolling is not None and not isinstance(rolling, RollingResistance):
             raise InputError(f"rolling must be a tdem.RollingResistance or None, "
                              f"got {rolling!r}")
@@ -86,6 +225,7 @@ class ContactLaw:
         return [r.delta, float(r.model), 1.0 if r.damping else 0.0]
 
     def to_dict(self):
+        """The constructor's arguments (and ``type``, the class name)."""
         d = {k: v for k, v in self.__dict__.items() if not k.startswith("_") and k != "rolling"}
         d["type"] = type(self).__name__
         if self.rolling is not None:
@@ -94,10 +234,8 @@ class ContactLaw:
 
     @staticmethod
     def from_dict(d):
-        from .hertz_mindlin import HertzMindlin
-        from .linear import LinearContact
         d = dict(d)
-        cls = {"LinearContact": LinearContact, "HertzMindlin": HertzMindlin}[d.pop("type")]
+        cls = law_class(d.pop("type"))
         if "rolling" in d:
             d["rolling"] = RollingResistance(**d["rolling"])
         return cls(**d)
@@ -107,6 +245,7 @@ class ContactLaw:
         return f"{type(self).__name__}({args})"
 
 
+# ------------------------------------------------------------- shared pieces of laws
 @ti.func
 def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt, fs_old):
     """Coulomb limit |F_s| <= F_n tan(phi) + c (C&S Eq. 19), keeping the sign.
@@ -133,59 +272,96 @@ def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt, fs_old):
 
 
 @ti.func
-def pair_force(lawp: ti.template(), L, u, vn, vs, meff, reff, dt, fs_old):
-    """Forces of one contact in its local frame (n from i to j, t = n rotated +90°).
-
-    u: overlap (> 0), vn, vs: relative velocity of j w.r.t. i along n and t,
-    meff: m* (m_i for a wall), reff: R* = R_i R_j/(R_i+R_j) (R_i for a wall).
-    Returns (F_n elastic, F_n total, F_s spring, F_s total, tangent k_n, c_n, dissipation),
-    F_n compression-positive.
-    """
-    kind = ti.cast(lawp[L, 0], ti.i32)
-    fn_el = 0.0
-    kn = 0.0
-    ks = 0.0
-    if kind == LINEAR:
-        kn = lawp[L, 1]
-        ks = lawp[L, 2]
-        fn_el = kn * u
-    else:
-        # Hertz (Miyata Eqs. 24, 27, 31): a = sqrt(R* u)
-        a = ti.sqrt(reff * u)
-        fn_el = 4.0 / 3.0 * lawp[L, 1] * a * u
-        kn = 2.0 * lawp[L, 1] * a
-        ks = 8.0 * lawp[L, 2] * a
-    beta = lawp[L, 5]
-    cn = beta * kn + lawp[L, 6] * ti.sqrt(kn * meff)
+def spring_dashpot(fn_el, kn, ks, beta, gamma, u, vn, vs, meff, mu, coh, dt, h):
+    """Normal dashpot c_n = β k_n + γ_e sqrt(k_n m*) and the incremental Coulomb
+    shear spring in h[0], shared by the linear and Hertz–Mindlin laws. Returns the
+    tuple of :meth:`ContactLaw.force`."""
+    cn = beta * kn + gamma * ti.sqrt(kn * meff)
     cs = beta * ks
     fn = fn_el - cn * vn
-    fs, fs_tot, diss = coulomb_shear(fs_old + ks * vs * dt, fn_el, lawp[L, 3], lawp[L, 4],
-                                     ks, cs, vs, dt, fs_old)
+    fs_old = h[0]
+    fs, fs_tot, diss = coulomb_shear(fs_old + ks * vs * dt, fn_el, mu, coh, ks, cs, vs, dt,
+                                     fs_old)
     diss += cn * vn * vn * dt
-    return fn_el, fn, fs, fs_tot, kn, cn, diss
+    h[0] = fs
+    return fn_el, fn, fs_tot, kn, cn, diss, h
+
+
+# ------------------------------------------------------------------- dispatch
+@ti.func
+def _params(laws: ti.template(), c: ti.template(), lawp: ti.template(), L):
+    return ti.Vector([lawp[L, COL_PARAMS + j] for j in ti.static(range(len(laws[c].params)))])
 
 
 @ti.func
-def elastic_energy(lawp: ti.template(), L, u, reff, fs, moment, rbar):
-    """Energy stored in the springs of one contact (normal, shear, rolling)."""
-    kind = ti.cast(lawp[L, 0], ti.i32)
-    e = 0.0
+def law_force(laws: ti.template(), lawp: ti.template(), L, u, vn, vs, meff, reff, dt, h):
+    """Forces of one contact by the law of row L of the table (module docstring), in
+    the contact's frame (n from i to j, t = n rotated +90°). Returns
+    (F_n elastic, F_n total, F_s total, tangent k_n, c_n, dissipation, history)."""
+    code = ti.cast(lawp[L, COL_CODE], ti.i32)
+    fn_el = 0.0
+    fn = 0.0
+    fs_tot = 0.0
     kn = 0.0
-    ks = 0.0
-    if kind == LINEAR:
-        kn = lawp[L, 1]
-        ks = lawp[L, 2]
-        e = 0.5 * kn * u * u
-    else:
-        a = ti.sqrt(reff * u)
-        kn = 2.0 * lawp[L, 1] * a
-        ks = 8.0 * lawp[L, 2] * a
-        e = 0.4 * (4.0 / 3.0 * lawp[L, 1] * a * u) * u
-    if ks > 0.0:
-        e += 0.5 * fs * fs / ks
-    delta = lawp[L, 7]
-    if delta > 0.0 and kn > 0.0:
-        b = delta * rbar
-        km = kn * b * b / 12.0
-        e += 0.5 * moment * moment / km
+    cn = 0.0
+    diss = 0.0
+    hout = h
+    for c in ti.static(range(len(laws))):
+        if code == c:
+            q = _params(laws, c, lawp, L)
+            fn_el, fn, fs_tot, kn, cn, diss, hout = ti.static(laws[c].force)(
+                q, u, vn, vs, meff, reff, dt, h)
+    return fn_el, fn, fs_tot, kn, cn, diss, hout
+
+
+@ti.func
+def law_energy(laws: ti.template(), lawp: ti.template(), L, u, reff, h):
+    """Energy stored in the normal and tangential springs of one contact."""
+    code = ti.cast(lawp[L, COL_CODE], ti.i32)
+    e = 0.0
+    for c in ti.static(range(len(laws))):
+        if code == c:
+            q = _params(laws, c, lawp, L)
+            e = ti.static(laws[c].energy)(q, u, reff, h)
     return e
+
+
+@ti.func
+def law_stiffness(laws: ti.template(), lawp: ti.template(), L, u, reff):
+    """Tangent normal stiffness of one contact (the rolling spring's energy needs it)."""
+    code = ti.cast(lawp[L, COL_CODE], ti.i32)
+    kn = 0.0
+    for c in ti.static(range(len(laws))):
+        if code == c:
+            q = _params(laws, c, lawp, L)
+            kn = ti.static(laws[c].stiffness)(q, u, reff)
+    return kn
+
+
+@ti.func
+def zero_history(h):
+    """The history vector h with every column 0 (whatever its width)."""
+    for c in ti.static(range(h.n)):
+        h[c] = 0.0
+    return h
+
+
+def remap_history(h, width, tail):
+    """History array ``h`` (…, w) with ``width`` columns: the law columns (the first
+    w − tail) are kept, cut or padded with zeros; the last ``tail`` columns (rolling,
+    u0) stay last. A pair history of 4 columns, written before the overlap offset u0
+    existed, gets u0 = 0."""
+    import numpy as np
+
+    h = np.asarray(h)
+    if tail == 4 and h.shape[-1] == 4:
+        h = np.concatenate([h, np.zeros(h.shape[:-1] + (1,))], axis=-1)
+    if h.shape[-1] == width:
+        return h
+    nlaw_old = h.shape[-1] - tail
+    nlaw = width - tail
+    out = np.zeros(h.shape[:-1] + (width,), dtype=h.dtype)
+    keep = min(nlaw_old, nlaw)
+    out[..., :keep] = h[..., :keep]
+    out[..., nlaw:] = h[..., nlaw_old:]
+    return out

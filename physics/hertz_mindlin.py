@@ -13,13 +13,18 @@ forms, which go with the 4/3 prefactor. The sphere formula is used for discs, as
 Miyata Eq. 17 evaluated with the current tangent stiffness.
 """
 import numpy as np
+import taichi as ti
 
-from .contact_law import HERTZ, ContactLaw
+from .contact_law import ContactLaw, register_law, spring_dashpot
 from .validate import in_range, positive
 
 
+@register_law
 class HertzMindlin(ContactLaw):
     """Non-linear Hertz normal contact with Mindlin tangential stiffness."""
+
+    params = ("e_star", "g_star", "friction", "cohesion", "damping_ratio", "_gamma")
+    history = ("shear",)
 
     def __init__(self, young, poisson, friction=0.5, restitution=None, cohesion=0.0,
                  damping_ratio=0.0, rolling=None):
@@ -36,9 +41,28 @@ class HertzMindlin(ContactLaw):
         g = self.young / (2.0 * (1.0 + self.poisson))
         return g / (2.0 * (2.0 - self.poisson))
 
-    def row(self):
-        return [float(HERTZ), self.e_star, self.g_star, self.friction, self.cohesion,
-                self.damping_ratio, self._gamma] + self._rolling_columns() + [0.0, 0.0]
+    @staticmethod
+    @ti.func
+    def force(q, u, vn, vs, meff, reff, dt, h):
+        # Hertz (Miyata Eqs. 24, 27, 31): a = sqrt(R* u)
+        a = ti.sqrt(reff * u)
+        return spring_dashpot(4.0 / 3.0 * q[0] * a * u, 2.0 * q[0] * a, 8.0 * q[1] * a,
+                              q[4], q[5], u, vn, vs, meff, q[2], q[3], dt, h)
+
+    @staticmethod
+    @ti.func
+    def energy(q, u, reff, h):
+        a = ti.sqrt(reff * u)
+        ks = 8.0 * q[1] * a
+        e = 0.4 * (4.0 / 3.0 * q[0] * a * u) * u
+        if ks > 0.0:
+            e += 0.5 * h[0] * h[0] / ks
+        return e
+
+    @staticmethod
+    @ti.func
+    def stiffness(q, u, reff):
+        return 2.0 * q[0] * ti.sqrt(reff * u)
 
     def critical_stiffness(self, radius, mass):
         """Tangent stiffness at an overlap of 5 % of the radius (a conservative bound)."""

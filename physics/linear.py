@@ -9,13 +9,17 @@ while sliding), or a normal dashpot from a coefficient of restitution e
 
 The contact lasts while the overlap is positive; the normal force is not clipped
 at zero, so that a restitution-based dashpot gives exactly the restitution e of
-Eq. 17. The kernel side is in :func:`physics.contact_law.pair_force`.
+Eq. 17. The kernel side is :meth:`LinearContact.force`.
 """
+import taichi as ti
+
 from tdem.errors import InputError
 
-from .contact_law import LINEAR, ContactLaw
+from .contact_law import ContactLaw, register_law, spring_dashpot
 from .validate import positive
 
+
+@register_law
 
 class LinearContact(ContactLaw):
     """Linear spring–dashpot contact with Coulomb friction.
@@ -36,6 +40,9 @@ class LinearContact(ContactLaw):
         Rolling resistance of Jiang et al. (2005).
     """
 
+    params = ("kn", "ks", "friction", "cohesion", "damping_ratio", "_gamma")
+    history = ("shear",)
+
     def __init__(self, kn, ks=None, friction=0.5, cohesion=0.0, restitution=None,
                  damping_ratio=0.0, rolling=None):
         self.kn = positive("kn", kn)
@@ -49,9 +56,24 @@ class LinearContact(ContactLaw):
             raise InputError(f"ks must be a number >= 0, got {ks!r}")
         self._set_common(friction, cohesion, restitution, damping_ratio, rolling)
 
-    def row(self):
-        return [float(LINEAR), self.kn, self.ks, self.friction, self.cohesion,
-                self.damping_ratio, self._gamma] + self._rolling_columns() + [0.0, 0.0]
-
     def critical_stiffness(self, radius, mass):
         return max(self.kn, self.ks)
+
+    @staticmethod
+    @ti.func
+    def force(q, u, vn, vs, meff, reff, dt, h):
+        kn = q[0]
+        return spring_dashpot(kn * u, kn, q[1], q[4], q[5], u, vn, vs, meff, q[2], q[3], dt, h)
+
+    @staticmethod
+    @ti.func
+    def energy(q, u, reff, h):
+        e = 0.5 * q[0] * u * u
+        if q[1] > 0.0:
+            e += 0.5 * h[0] * h[0] / q[1]
+        return e
+
+    @staticmethod
+    @ti.func
+    def stiffness(q, u, reff):
+        return q[0]

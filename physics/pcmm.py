@@ -96,6 +96,7 @@ from tdem.errors import CapacityError, InputError
 from tdem.launch import cached
 
 from . import fvm
+from .contact_law import zero_history
 from .materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
 from .validate import positive
 
@@ -1659,18 +1660,21 @@ def _set_skip(i, k, j, skip, pos: ti.template(), prop: ti.template(), cskip: ti.
               hist: ti.template()):
     """Pair slot k of i (partner j) takes the mark ``skip`` (see :func:`gather`). The
     pair's history says whether elements carried it at the last mark: its overlap
-    entry (4) is CARRIED (< 0) then, an overlap ≥ 0 otherwise. A pair that elements
+    entry (u0, the last column) is CARRIED (< 0) then, an overlap ≥ 0 otherwise. A pair that elements
     stop carrying starts the contact law afresh, counting from its overlap now
     (:func:`tdem.step.pair_contact`), so that the law takes over without a jump."""
     cskip[i, k] = skip
     h = hist[i, k]
+    u0 = ti.static(h.n - 1)
     if skip == 1:
-        if h[4] >= 0.0:
-            h[4] = CARRIED
+        if h[u0] >= 0.0:
+            h[u0] = CARRIED
             hist[i, k] = h
-    elif h[4] < 0.0:
+    elif h[u0] < 0.0:
         u = prop[i][0] + prop[j][0] - (pos[j] - pos[i]).norm()
-        hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, ti.max(u, 0.0)])
+        h = zero_history(h)
+        h[u0] = ti.max(u, 0.0)
+        hist[i, k] = h
 
 
 def update(a, e, dt, time, first, full, carry, eos, serial):

@@ -17,6 +17,9 @@ from tdem.errors import InputError
 
 from .validate import non_negative
 
+# the law table's columns of rolling resistance (physics.contact_law)
+COL_ROLL_DELTA, COL_ROLL_MODEL, COL_ROLL_DAMP = 1, 2, 3
+
 
 class RollingResistance:
     """Rolling resistance at a contact (attach to a contact law's ``rolling``)."""
@@ -43,8 +46,8 @@ def rolling_couple(lawp: ti.template(), L, fn_el, kn, cn, rbar, dw, dt, m_old, t
     cn the normal dashpot. Returns (spring couple, total couple on i, accumulated θ_r,
     broken flag, dissipated energy).
     """
-    delta = lawp[L, 7]
-    model = ti.cast(lawp[L, 8], ti.i32)
+    delta = lawp[L, COL_ROLL_DELTA]
+    model = ti.cast(lawp[L, COL_ROLL_MODEL], ti.i32)
     th = th_old + dw * dt
     m = 0.0
     m_tot = 0.0
@@ -73,8 +76,20 @@ def rolling_couple(lawp: ti.template(), L, fn_el, kn, cn, rbar, dw, dt, m_old, t
                 m = 0.0
                 limited = True
         m_tot = m
-        if lawp[L, 9] > 0.5 and not limited:
+        if lawp[L, COL_ROLL_DAMP] > 0.5 and not limited:
             mu_m = cn * b * b / 12.0
             m_tot -= mu_m * dw
             diss += mu_m * dw * dw * dt
     return m, m_tot, th, brk, diss
+
+
+@ti.func
+def rolling_energy(lawp: ti.template(), L, kn, moment, rbar):
+    """Energy stored in the rolling spring, M²/(2 K_m)."""
+    e = 0.0
+    delta = lawp[L, COL_ROLL_DELTA]
+    if delta > 0.0 and kn > 0.0:
+        b = delta * rbar
+        km = kn * b * b / 12.0
+        e = 0.5 * moment * moment / km
+    return e

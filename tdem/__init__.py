@@ -1,13 +1,14 @@
 """tdem: continuum–discontinuum simulation in geomechanics, on Taichi.
 
 The public API (see README): :class:`Simulation`, the contact laws
-:class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance`, the
+:class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance` (and
+:class:`ContactLaw` with :func:`register_law` for laws of one's own), the
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
 :class:`InputError`, :class:`InstabilityError`.
 """
 from coupling import PointEdge
-from physics import HertzMindlin, LinearContact, RollingResistance
+from physics import ContactLaw, HertzMindlin, LinearContact, RollingResistance, register_law
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 
 from . import mesh, pack
@@ -16,6 +17,7 @@ from .simulation import Block, ParticleGroup, Simulation, Wall
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "LinearContact", "HertzMindlin",
+__all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "ContactLaw", "register_law",
+           "LinearContact", "HertzMindlin",
            "RollingResistance", "PointEdge", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack"]

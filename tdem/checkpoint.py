@@ -32,6 +32,7 @@ import warnings
 
 import numpy as np
 
+from .continuum import SAVED as CONTINUUM_SAVED
 from .errors import InputError
 from .step import WALL_WIDTH
 
@@ -145,7 +146,7 @@ def save(sim, path):
             sim._cont.sync_copies()
             cg = f.create_group("continuum")
             for k, arr in sim._cont.a.items():
-                if k in _CONTINUUM_STATE:
+                if k in CONTINUUM_SAVED:
                     cg.create_dataset(k, data=arr.to_numpy())
             for kind in sim._cont.nr:
                 ng = f.create_group(f"nonreflecting_{kind}")
@@ -154,11 +155,6 @@ def save(sim, path):
     return path
 
 
-# the continuum's state (the rest is set up again from the host description)
-_CONTINUUM_STATE = ("psig", "peps", "pstate", "pjwl", "xforce", "cand", "ccnt", "pflags", "elem",
-                    "ecnt", "esig", "npos",
-                    "npos0", "nvel", "nforce", "nreact", "tsig", "tstate", "nflags",
-                    "psedge", "psforce", "psbroken", "vsedge", "vsforce", "vsbroken", "rstate")
 
 
 def load(path, arch=None):

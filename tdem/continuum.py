@@ -44,6 +44,9 @@ _SNAP_PARTICLES = ("psig", "peps", "pstate", "pjwl", "xforce", "ccnt", "ecnt", "
 _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig", "tstate",
                            "nflags", "psedge", "psforce", "psbroken", "vsedge", "vsforce",
                            "vsbroken", "rstate")
+# what a checkpoint saves: the dynamic state and the nodes' initial positions (the rest
+# is set up again from the host description)
+SAVED = _SNAP + ("npos0",)
 
 
 @cached

@@ -28,6 +28,8 @@ simulation grows the arrays and redoes the steps since its last check.
 """
 import taichi as ti
 
+from physics.contact_law import zero_history
+
 from .launch import cached
 
 # indices in the int status array ``flags``
@@ -153,14 +155,14 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             ncnt[i] = m
             for k in range(m):
                 j = nbr[i, k]
-                h = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
+                h = zero_history(hist[i, k])
                 for kk in range(ncnt_old[i]):
                     if nbr_old[i, kk] == j:
                         h = hist_old[i, kk]
                 hist[i, k] = h
             for k in range(m, cap):
                 nbr[i, k] = -1
-                hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0])
+                hist[i, k] = zero_history(hist[i, k])
             xref[i] = xi
             rcnt[i] = 0
     # 6. reverse lists (who names me), then sorted for a fixed summation order
@@ -200,7 +202,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                 d = a + sp * ab - xi
                 if d.dot(d) < cut * cut:
                     if cnt < capw:
-                        h = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                        h = zero_history(whist[i, 0])
                         for s in range(capw):
                             if wid_old[i, s] == w:
                                 h = whist_old[i, s]
@@ -210,7 +212,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             ti.atomic_max(flags[F_WALL_NEED], cnt)
             for s in range(cnt, capw):
                 wid[i, s] = -1
-                whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                whist[i, s] = zero_history(whist[i, s])
     ti.loop_config(serialize=True)
     for w in range(nwalls):
         if flags[F_REBUILD] != 0:

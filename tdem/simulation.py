@@ -18,13 +18,14 @@ import time as _time
 import numpy as np
 import taichi as ti
 
-from physics.contact_law import LAW_WIDTH, ContactLaw
+from physics import contact_law as _claw
+from physics.contact_law import ContactLaw
 from physics.linear import LinearContact
 from physics.materials import Material, MohrCoulomb
 
 from . import backend, neighbors
 from . import mesh as _mesh
-from . import snapshot
+from . import state as schema
 from . import step as stepk
 from .continuum import Continuum
 from .errors import CapacityError, InputError, InstabilityError
@@ -32,18 +33,7 @@ from .neighbors import F_BAD, F_BUILDS, F_NEED, F_REBUILD, F_WALL_NEED, FLAGS_SI
 
 MAX_SLOTS = 1024
 
-# name: (components, per-slot?, dtype kind). components 0 = scalar.
-_PARTICLE = {
-    "pos": 2, "vel": 2, "omega": 0, "prop": 3, "plaw": "i", "fix": "i", "vfix": 3,
-    "force": 2, "torque": 0, "xref": 2, "pos0": 2, "facc": 3, "eacc": 2, "estate": 2,
-}
-_SLOTS = {"nbr": "i", "hist": 5, "cn": 2, "cf": 3, "cs": 3, "rev": "i",
-          "nbr_old": "i", "hist_old": 5, "cskip": "i"}
-_COUNTS = ("ncnt", "rcnt", "ncnt_old")
-_WSLOTS = {"wid": "i", "whist": 4, "wcn": 2, "wcf": 4, "wcs": 3, "wid_old": "i", "whist_old": 4}
-# arrays rebuilt from scratch whenever needed (never saved or restored)
-_SCRATCH = ("stress_out", "cell_count", "cell_start", "sorted", "pcell", "bounds", "nbr_old", "hist_old",
-            "ncnt_old", "simp", "lawp", "lawpair", "facc", "wid_old", "whist_old", "cskip")
+# the engine's arrays are declared in tdem.state
 
 
 def _vector2(name, value):
@@ -355,6 +345,7 @@ class Simulation:
         self._dt_user = None
         # host-side description
         self._laws = []            # ContactLaw objects, index = law id
+        self._law_set = _claw.registered()   # the law classes the kernels compile for
         self._pair_override = {}   # (law a, law b) -> law id
         self._groups = []
         self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat")}
@@ -394,6 +385,9 @@ class Simulation:
         if not isinstance(law, ContactLaw):
             raise InputError(f"{argname} must be a contact law such as tdem.LinearContact(...), "
                              f"got {law!r}")
+        if not _claw.is_registered(type(law)):
+            raise InputError(f"{argname}: the contact law {type(law).__name__} is not registered: "
+                             f"decorate its class with @tdem.register_law")
         for k, known in enumerate(self._laws):
             if known is law:
                 return k
@@ -876,39 +870,18 @@ class Simulation:
         return t
 
     # ------------------------------------------------------------ device state
-    def _alloc(self, spec, shape):
-        if spec == "i":
-            return ti.ndarray(ti.i32, shape)
-        if spec == 0:
-            return ti.ndarray(self._fdt, shape)
-        return ti.Vector.ndarray(spec, self._fdt, shape)
+    def _sizes(self, n, cap, capw, nwalls, nlaws, ncell):
+        """The sizes :func:`tdem.state.allocate` takes, for this model."""
+        return {"n": n, "cap": cap, "capw": capw, "walls": max(nwalls, 1), "laws": nlaws,
+                "law_width": _claw.table_width(self._law_set), "cells": ncell,
+                "cell_starts": ncell + 4096, "flags": FLAGS_SIZE, "simp": stepk.SIMP_SIZE,
+                "wall_width": stepk.WALL_WIDTH, "laws_set": self._law_set}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
-        a = {}
-        for k, spec in _PARTICLE.items():
-            a[k] = self._alloc(spec, (n,))
-        for k, spec in _SLOTS.items():
-            a[k] = self._alloc(spec, (n, cap))
-        for k in _COUNTS:
-            a[k] = ti.ndarray(ti.i32, (n,))
-        for k, spec in _WSLOTS.items():
-            a[k] = self._alloc(spec, (n, capw))
-        a["wall"] = ti.ndarray(ti.f64, (max(nwalls, 1), stepk.WALL_WIDTH))
-        a["wforce"] = ti.Vector.ndarray(4, ti.f64, (max(nwalls, 1),))  # fx, fy, moment, contacts
-        a["lawp"] = ti.ndarray(ti.f64, (nlaws, LAW_WIDTH))
-        a["lawpair"] = ti.ndarray(ti.i32, (nlaws, nlaws))
-        a["flags"] = ti.ndarray(ti.i32, (FLAGS_SIZE,))
-        a["simp"] = ti.ndarray(ti.f64, (stepk.SIMP_SIZE,))
-        a["cell_count"] = ti.ndarray(ti.i32, (ncell,))
-        a["cell_start"] = ti.ndarray(ti.i32, (ncell + 4096,))
-        a["sorted"] = ti.ndarray(ti.i32, (n,))
-        a["pcell"] = ti.ndarray(ti.i32, (n,))
-        a["gridp"] = ti.ndarray(ti.f64, (4,))
-        a["gridn"] = ti.ndarray(ti.i32, (4,))
-        a["bounds"] = ti.ndarray(ti.f64, (5,))
-        return a
+        return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
 
     def _fresh_state(self):
+        self._law_set = _claw.registered()
         pos = np.concatenate(self._host["pos"])
         vel = np.concatenate(self._host["vel"])
         r = np.concatenate(self._host["radius"])
@@ -918,20 +891,18 @@ class Simulation:
             pm = self._cont.masses
             m = np.where(np.isnan(pm), m, pm)
         n = len(r)
-        s = {
-            "pos": pos, "vel": vel, "omega": np.zeros(n), "pos0": pos.copy(),
-            "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
-            "plaw": np.concatenate(self._host["law"]).astype(np.int32),
-            "fix": np.zeros(n, np.int32), "vfix": np.zeros((n, 3)),
-            "force": np.zeros((n, 2)), "torque": np.zeros(n), "xref": pos.copy(),
-            "eacc": np.zeros((n, 2)), "estate": np.zeros((n, 2)),
-            "nbr": -np.ones((n, self._cap), np.int32), "ncnt": np.zeros(n, np.int32),
-            "hist": np.zeros((n, self._cap, 5)),
-            "wid": -np.ones((n, self._capw), np.int32),
-            "whist": np.zeros((n, self._capw, 4)),
-            "flags": np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32),
-        }
+        s = self._new_rows(pos, vel, r, m, np.concatenate(self._host["law"]), self._cap,
+                           self._capw)
+        s["flags"] = np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32)
         return s
+
+    def _new_rows(self, pos, vel, r, m, law, cap, capw):
+        """State rows of new particles (every saved per-particle and per-slot array)."""
+        sizes = self._sizes(len(r), cap, capw, 1, 1, 1)
+        return schema.fresh_rows(len(r), sizes, {
+            "pos": pos, "vel": vel, "pos0": pos, "xref": pos,
+            "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
+            "plaw": np.broadcast_to(np.asarray(law, np.int32), (len(r),))})
 
     def _build(self):
         if self._n == 0 and not self._blocks:
@@ -967,21 +938,13 @@ class Simulation:
 
     def _rebuild_from(self, state, new_particles=None):
         """(Re)allocate every array for the current sizes and fill it from ``state``."""
+        self._set_law_set(state)
         if new_particles is not None:
             pos, vel, r, rho, law = new_particles
             m = rho * np.pi * r ** 2
             n = len(r)
-            add = {"pos": pos, "vel": vel, "omega": np.zeros(n), "pos0": pos.copy(),
-                   "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
-                   "plaw": np.full(n, law, np.int32), "fix": np.zeros(n, np.int32),
-                   "vfix": np.zeros((n, 3)), "force": np.zeros((n, 2)), "torque": np.zeros(n),
-                   "xref": pos.copy(), "eacc": np.zeros((n, 2)),
-                   "estate": np.zeros((n, 2)),
-                   "nbr": -np.ones((n, state["nbr"].shape[1]), np.int32),
-                   "ncnt": np.zeros(n, np.int32),
-                   "hist": np.zeros((n, state["hist"].shape[1], 5)),
-                   "wid": -np.ones((n, state["wid"].shape[1]), np.int32),
-                   "whist": np.zeros((n, state["whist"].shape[1], 4))}
+            add = self._new_rows(pos, vel, r, m, law, state["nbr"].shape[1],
+                                 state["wid"].shape[1])
             for k, v in add.items():
                 state[k] = np.concatenate([state[k], v])
             state["flags"][F_REBUILD] = 1
@@ -1017,12 +980,22 @@ class Simulation:
 
     def _download(self):
         """Every device array as numpy; the host copy of the walls follows the device."""
-        state = {k: v.to_numpy() for k, v in self._a.items() if k not in _SCRATCH}
-        self._walls_host = list(state["wall"][:len(self._walls_host)])
-        return state
+        out = {k: self._a[k].to_numpy() for k in schema.saved()}
+        self._walls_host = list(out["wall"][:len(self._walls_host)])
+        return out
+
+    def _set_law_set(self, state):
+        """Take the contact laws registered now (the kernels' ``laws``); the history
+        arrays of ``state`` get the columns these laws need."""
+        self._law_set = _claw.registered()
+        for k, width in (("hist", _claw.pair_history_width(self._law_set)),
+                         ("whist", _claw.wall_history_width(self._law_set))):
+            if k in state:
+                state[k] = _claw.remap_history(state[k], width, tail=4 if k == "hist" else 3)
 
     def _upload_laws(self):
-        rows = np.array([law.row() for law in self._laws], dtype=float)
+        width = _claw.table_width(self._law_set)
+        rows = np.array([law.row(width) for law in self._laws], dtype=float)
         self._a["lawp"].from_numpy(rows)
         self._a["lawpair"].from_numpy(self._law_table())
 
@@ -1128,13 +1101,9 @@ class Simulation:
 
     # ------------------------------------------------------------------ stepping
     def _step_args(self):
-        a = self._a
-        return (a["pos"], a["vel"], a["omega"], a["prop"], a["plaw"], a["fix"], a["vfix"],
-                a["force"], a["torque"], a["xref"], a["facc"], a["eacc"], a["estate"],
-                a["nbr"], a["ncnt"], a["hist"],
-                a["cn"], a["cf"], a["cs"], a["rev"], a["rcnt"], a["wall"], a["wforce"],
-                a["wid"], a["whist"], a["wcn"], a["wcf"], a["wcs"], a["lawp"], a["lawpair"],
-                a["flags"], a["simp"], self._xforce(), a["cskip"], self._serial())
+        # the arrays by name; _one_step appends the last three (detail, continuum, laws)
+        return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
+                           detail=False, continuum=False, laws=self._law_set)[:-3]
 
     def _xforce(self):
         if self._cont is not None:
@@ -1166,12 +1135,8 @@ class Simulation:
         return self._step_args(), self._rebuild_args()
 
     def _rebuild_args(self):
-        a = self._a
-        return (a["pos"], a["prop"], a["xref"], a["nbr"], a["ncnt"], a["hist"], a["nbr_old"],
-                a["ncnt_old"], a["hist_old"], a["rev"], a["rcnt"], a["cell_count"],
-                a["cell_start"], a["sorted"], a["pcell"], a["gridp"], a["gridn"], a["flags"],
-                a["wall"], a["wid"], a["whist"], a["wid_old"], a["whist_old"],
-                len(self._walls_host), float(self.skin))
+        return schema.bind(neighbors.rebuild, self._a, sorted_ids=self._a["sorted"],
+                           nwalls=len(self._walls_host), skin=float(self.skin))
 
     def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
         """One step, the whole data flow (continua: see :mod:`tdem.continuum`)."""
@@ -1186,7 +1151,7 @@ class Simulation:
         if cont is not None:
             cont.before_forces(self, self._dt_run, self._reach)
         if self._n:
-            stepk.step(*step_args, detail, cont is not None and cont.adds_forces)
+            stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set)
         if cont is not None:
             cont.after_step(self)
         self._time += self._dt_run
@@ -1198,26 +1163,20 @@ class Simulation:
         self._snap_clock = (self._time, self._steps)
         if self._n == 0:
             return
-        for k in snapshot.ORDER:
+        names = schema.dynamic()
+        for k in names:
             src = self._a[k]
             dst = self._snap.get(k)
             if dst is None or tuple(dst.shape) != tuple(src.shape):
-                self._snap[k] = self._alloc_like(src)
-        snapshot.copy_state(*[self._a[k] for k in snapshot.ORDER],
-                            *[self._snap[k] for k in snapshot.ORDER], self._serial())
+                self._snap[k] = schema.like(src)
+        schema.copy(self._a, self._snap, names, self._serial())
         self._snap_clock = (self._time, self._steps)
-
-    def _alloc_like(self, src):
-        if hasattr(src, "n"):
-            return ti.Vector.ndarray(src.n, src.dtype, tuple(src.shape))
-        return ti.ndarray(src.dtype, tuple(src.shape))
 
     def _restore_snapshot(self):
         if self._cont is not None:
             self._cont.restore_snapshot()
         if self._n:
-            snapshot.copy_state(*[self._snap[k] for k in snapshot.ORDER],
-                                *[self._a[k] for k in snapshot.ORDER], self._serial())
+            schema.copy(self._snap, self._a, schema.dynamic(), self._serial())
         self._time, self._steps = self._snap_clock
         for m in self._monitors:
             m.truncate(self._steps)
@@ -1426,9 +1385,7 @@ class Simulation:
             sa = self._a.get("stress_out")
             if sa is None or sa.shape[0] != self._n:
                 sa = self._a["stress_out"] = ti.ndarray(ti.f64, (self._n, 3))
-            stepk.particle_stress(a["prop"], a["nbr"], a["ncnt"], a["cn"], a["cf"], a["cs"],
-                                  a["rev"], a["rcnt"], a["wid"], a["wcn"], a["wcf"], a["wcs"],
-                                  sa)
+            stepk.particle_stress(*schema.bind(stepk.particle_stress, a, out=sa))
             s = sa.to_numpy()
             st = np.zeros((self._n, 2, 2))
             st[:, 0, 0], st[:, 1, 1] = s[:, 0], s[:, 1]
@@ -1488,12 +1445,13 @@ class Simulation:
         wu = wcs[wi, wk, 2]
         wn = a["wcn"].to_numpy()[wi, wk]
         whist = a["whist"].to_numpy()
+        R = _claw.history_width(self._law_set)     # the rolling couple's column
         return {
             "pairs": np.concatenate([np.stack([ii, jj], 1),
                                      np.stack([wi, -1 - wid[wi, wk]], 1)]).astype(np.int64),
             "normal": np.concatenate([cs[ii, kk, 0], wcs[wi, wk, 0]]),
             "shear": np.concatenate([cs[ii, kk, 1], wcs[wi, wk, 1]]),
-            "moment": np.concatenate([hist[ii, kk, 1], whist[wi, wk, 1]]),
+            "moment": np.concatenate([hist[ii, kk, R], whist[wi, wk, R]]),
             "direction": np.concatenate([normal_dir, wn]),
             "overlap": np.concatenate([u, wu]),
             "point": np.concatenate([pts, pos[wi] + (r[wi] - 0.5 * wu)[:, None] * wn]),
@@ -1537,9 +1495,8 @@ class Simulation:
         a = self._a
         eacc = a["eacc"].to_numpy()
         estate = a["estate"].to_numpy()
-        el = stepk.elastic_energy_sum(a["pos"], a["prop"], a["plaw"], a["nbr"], a["ncnt"],
-                                      a["hist"], a["cs"], a["wall"], a["wid"], a["whist"],
-                                      a["wcs"], a["lawp"], a["lawpair"])
+        el = stepk.elastic_energy_sum(*schema.bind(stepk.elastic_energy_sum, a,
+                                                   laws=self._law_set))
         e = {"kinetic": float(estate[:, 0].sum()), "gravitational": float(estate[:, 1].sum()),
              "elastic": float(el), "dissipated": float(eacc[:, 0].sum()),
              "boundary_work": float(eacc[:, 1].sum())}

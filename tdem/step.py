@@ -14,8 +14,9 @@ Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
 """
 import taichi as ti
 
-from physics.contact_law import pair_force, elastic_energy
-from physics.rolling import rolling_couple
+from physics.contact_law import (history_width, law_energy, law_force, law_stiffness,
+                                 zero_history)
+from physics.rolling import rolling_couple, rolling_energy
 
 from .launch import cached
 from .neighbors import F_BAD, F_REBUILD, slot_bits
@@ -52,13 +53,18 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
                  omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                  lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                  hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-                 detail: ti.template()):
+                 detail: ti.template(), laws: ti.template()):
     """Contact in slot k of particle i (the owner, i < j); xi, vi, wi, ri, mi, li are
-    i's position, velocity, spin, radius, mass and law group.
+    i's position, velocity, spin, radius, mass and law group; ``laws`` the registered
+    contact laws (:mod:`physics.contact_law`).
 
     Updates the history and returns (f_i, M_i, M_j, dissipated energy). With
     ``detail`` also stores the normal, the scalar forces and the overlap (for
-    output, stress and energy)."""
+    output, stress and energy). The history vector holds the law's columns, the
+    rolling couple, rotation and broken flag (from column R) and the overlap offset
+    u0 (the last column)."""
+    R = ti.static(history_width(laws))
+    U0 = ti.static(R + 3)
     j = nbr[i, k]
     d = pos[j] - xi
     dist = d.norm()
@@ -69,7 +75,8 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     # overlap it had when they stopped carrying it (hist[4], recorded by
     # physics.pcmm.gather, lowered as the two separate): the contact law takes over
     # from the elements without a force jump (no energy from nowhere)
-    u0 = ti.min(hist[i, k][4], ti.max(u_geo, 0.0))
+    h = hist[i, k]
+    u0 = ti.min(h[U0], ti.max(u_geo, 0.0))
     u = u_geo - u0
     f = ti.Vector([0.0, 0.0])
     m_on_i = 0.0
@@ -89,21 +96,26 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         L = lawpair[li, plaw[j]]
         mj = pj[1]
         reff = ri * rj / (ri + rj)
-        h = hist[i, k]
-        fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
-            lawp, L, u, vn, vs, mi * mj / (mi + mj), reff, dt, h[0])
+        fn_el, fn, fs_tot, kn, cnd, d1, h = law_force(
+            laws, lawp, L, u, vn, vs, mi * mj / (mi + mj), reff, dt, h)
         m, m_tot, th, brk, d2 = rolling_couple(
-            lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[1], h[2], h[3])
+            lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
         f = -fn * n + fs_tot * t
         m_on_i = ai * fs_tot + m_tot
         m_on_j = aj * fs_tot - m_tot
-        hist[i, k] = ti.Vector([fs, m, th, brk, u0])
+        h[R] = m
+        h[R + 1] = th
+        h[R + 2] = brk
+        h[U0] = u0
+        hist[i, k] = h
         diss = d1 + d2
         if ti.static(detail):
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, fs_tot, u])
     else:
-        hist[i, k] = ti.Vector([0.0, 0.0, 0.0, 0.0, u0])
+        h = zero_history(h)
+        h[U0] = u0
+        hist[i, k] = h
         if ti.static(detail):
             cs[i, k] = ti.Vector([0.0, 0.0, u])
     return f, m_on_i, m_on_j, diss
@@ -113,10 +125,13 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
 def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
                   prop: ti.template(), wall: ti.template(), wforce: ti.template(),
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
-                  wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt):
+                  wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
+                  laws: ti.template()):
     """Contacts of particle i with its candidate walls (listed in its wall slots by the
     neighbour build). The wall is 'j', of infinite radius and mass. Returns
-    (force on i, moment on i, dissipation, work done by the walls)."""
+    (force on i, moment on i, dissipation, work done by the walls). The history holds
+    the law's columns, then the rolling couple, rotation and broken flag."""
+    R = ti.static(history_width(laws))
     xi = pos[i]
     ri = prop[i][0]
     diss = 0.0
@@ -148,13 +163,16 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             vs = vrel.dot(t)
             L = ti.cast(wall[w, W_LAW], ti.i32)
             h = whist[i, s]
-            fn_el, fn, fs, fs_tot, kn, cnd, d1 = pair_force(
-                lawp, L, u, vn, vs, prop[i][1], ri, dt, h[0])
+            fn_el, fn, fs_tot, kn, cnd, d1, h = law_force(
+                laws, lawp, L, u, vn, vs, prop[i][1], ri, dt, h)
             m, m_tot, th, brk, d2r = rolling_couple(
-                lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[1], h[2], h[3])
+                lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[R], h[R + 1], h[R + 2])
             f = -fn * n + fs_tot * t
             mi = ai * fs_tot + m_tot
-            whist[i, s] = ti.Vector([fs, m, th, brk])
+            h[R] = m
+            h[R + 1] = th
+            h[R + 2] = brk
+            whist[i, s] = h
             wcn[i, s] = n
             wcf[i, s] = ti.Vector([f[0], f[1], mi, 0.0])
             wcs[i, s] = ti.Vector([fn, fs_tot, u])
@@ -167,8 +185,8 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             ti.atomic_add(wforce[w][1], -f[1])
             ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
             ti.atomic_add(wforce[w][3], 1.0)
-        elif whist[i, s][0] != 0.0 or wcs[i, s][2] > 0.0 or whist[i, s][1] != 0.0:
-            whist[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+        elif whist[i, s][0] != 0.0 or wcs[i, s][2] > 0.0 or whist[i, s][R] != 0.0:
+            whist[i, s] = zero_history(whist[i, s])
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
             wcs[i, s] = ti.Vector([0.0, 0.0, ri - ti.sqrt(d2)])
     return ftot, mtot, diss, work
@@ -205,7 +223,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
-         serial: ti.template(), detail: ti.template(), continuum: ti.template()):
+         serial: ti.template(), detail: ti.template(), continuum: ti.template(),
+         laws: ti.template()):
     """One step. ``detail`` (a compile-time switch) also stores what only output
     reads: per-contact normals, scalar forces and overlaps, particle forces, and
     the kinetic and gravitational energy at t_n. The host asks for it on the last
@@ -265,7 +284,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     hist[i, k] = h0
                 fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel,
                                                omega, prop, plaw, lawp, lawpair, nbr, hist, cn,
-                                               cs, dt, detail)
+                                               cs, dt, detail, laws)
             f += fk
             tq += mk
             diss += dk
@@ -279,7 +298,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if skip != 1:      # (a carried pair's share is not read, see 2.)
                     cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
         fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
-                                         whist, wcn, wcf, wcs, dt)
+                                         whist, wcn, wcf, wcs, dt, laws)
         own = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw])
         if ti.static(serial):
             facc[i] += own
@@ -411,7 +430,9 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                        cs: ti.types.ndarray(), wall: ti.types.ndarray(),
                        wid: ti.types.ndarray(), whist: ti.types.ndarray(),
                        wcs: ti.types.ndarray(), lawp: ti.types.ndarray(),
-                       lawpair: ti.types.ndarray()) -> ti.f64:
+                       lawpair: ti.types.ndarray(), laws: ti.template()) -> ti.f64:
+    """Energy stored in the springs of every contact (law and rolling)."""
+    R = ti.static(history_width(laws))
     total = 0.0
     for i in range(pos.shape[0]):
         ri = prop[i][0]
@@ -422,16 +443,20 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                 rj = prop[j][0]
                 L = lawpair[plaw[i], plaw[j]]
                 h = hist[i, k]
-                total += elastic_energy(lawp, L, u, ri * rj / (ri + rj), h[0], h[1],
-                                        2.0 * ri * rj / (ri + rj))
+                reff = ri * rj / (ri + rj)
+                kn = law_stiffness(laws, lawp, L, u, reff)
+                total += law_energy(laws, lawp, L, u, reff, h) + rolling_energy(
+                    lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
         for s in range(wid.shape[1]):
             w = wid[i, s]
             if w >= 0:
                 u = wcs[i, s][2]
                 if u > 0.0:
                     h = whist[i, s]
-                    total += elastic_energy(lawp, ti.cast(wall[w, W_LAW], ti.i32), u, ri,
-                                            h[0], h[1], 2.0 * ri)
+                    L = ti.cast(wall[w, W_LAW], ti.i32)
+                    kn = law_stiffness(laws, lawp, L, u, ri)
+                    total += law_energy(laws, lawp, L, u, ri, h) + rolling_energy(
+                        lawp, L, kn, h[R], 2.0 * ri)
     return total
 
 

@@ -1,0 +1,198 @@
+"""The engine's state arrays, declared once.
+
+Every device array of the particle engine is one :class:`Array` of :data:`ENGINE`:
+its name (the key in ``Simulation._a`` and the kernels' parameter name), its owner
+(what its first index runs over), its components, its dtype and its role. The rest
+is derived from this table:
+
+- allocation (:func:`allocate`), for the sizes of a model;
+- fresh rows for particles being added (:func:`fresh_rows`), with each array's fill;
+- the restore point of a run segment (:func:`dynamic`, copied by :func:`copy`);
+- what a checkpoint saves (:func:`saved`) and the numpy views.
+
+Roles: ``dynamic`` arrays change during a run (a snapshot restores them, a checkpoint
+saves them); ``setup`` arrays are set by the host between runs (saved, not in the
+snapshot); ``scratch`` arrays are rebuilt whenever needed (neither).
+
+Owners and their shapes: ``particle`` (n,), ``slot`` (n, cap) the half neighbour
+list, ``wall_slot`` (n, capw) a particle's candidate walls, ``wall`` (walls,), and
+fixed-size tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's
+or a wall contact's history vector (as wide as the registered contact laws need,
+:mod:`physics.contact_law`).
+
+:mod:`tdem.continuum` keeps the PCMM, block and coupling arrays in the same way
+(``Continuum.a``, its snapshot list).
+"""
+from dataclasses import dataclass
+
+import taichi as ti
+
+from physics import contact_law
+
+from .launch import cached
+
+
+@dataclass(frozen=True)
+class Array:
+    name: str
+    owner: str            # particle | slot | wall_slot | wall | table
+    comps: object         # 0 scalar, k vector, "H" / "HW" history, (a, b) a 2-d table row
+    dtype: str            # "f": the simulation's precision, "f64", "i32"
+    role: str             # dynamic | setup | scratch
+    fill: float = 0.0     # value of a fresh entry
+    doc: str = ""
+
+
+# sizes a shape may name: n, cap, capw, walls (>= 1), laws, law_width, cells,
+# cell_starts; and fixed numbers
+ENGINE = (
+    # particles: kinematics, properties, prescribed motion
+    Array("pos", "particle", 2, "f", "dynamic", doc="position x_n (m)"),
+    Array("vel", "particle", 2, "f", "dynamic", doc="velocity v_{n-1/2} (m/s)"),
+    Array("omega", "particle", 0, "f", "dynamic", doc="spin (rad/s)"),
+    Array("prop", "particle", 3, "f", "setup", doc="radius (m), mass (kg/m), inertia"),
+    Array("plaw", "particle", "i", "i32", "setup", doc="law group of the particle"),
+    Array("fix", "particle", "i", "i32", "setup", doc="prescribed-velocity bits (step.FIX_*)"),
+    Array("vfix", "particle", 3, "f", "setup", doc="prescribed vx, vy, omega"),
+    Array("force", "particle", 2, "f", "dynamic", doc="contact + element force (output)"),
+    Array("torque", "particle", 0, "f", "dynamic", doc="moment (output)"),
+    Array("xref", "particle", 2, "f", "dynamic", doc="position at the last list build"),
+    Array("pos0", "particle", 2, "f", "setup", doc="position at the start (displacement)"),
+    Array("facc", "particle", 3, "f", "scratch", doc="force and moment sums of a step"),
+    Array("eacc", "particle", 2, "f", "dynamic", doc="dissipated energy, boundary work (J/m)"),
+    Array("estate", "particle", 2, "f", "dynamic", doc="kinetic, gravitational energy at t_n"),
+    Array("ncnt", "particle", "i", "i32", "dynamic", doc="length of the half list"),
+    Array("rcnt", "particle", "i", "i32", "dynamic", doc="length of the reverse list"),
+    Array("ncnt_old", "particle", "i", "i32", "scratch", doc="half list before a rebuild"),
+    # pair slots (half list, owner = lower index)
+    Array("nbr", "slot", "i", "i32", "dynamic", fill=-1, doc="partner index"),
+    Array("hist", "slot", "H", "f", "dynamic", doc="contact history (law, rolling, u0)"),
+    Array("cn", "slot", 2, "f", "dynamic", doc="contact normal (output)"),
+    Array("cf", "slot", 3, "f", "dynamic", doc="force on the owner, moment on the partner"),
+    Array("cs", "slot", 3, "f", "dynamic", doc="F_n, F_s, overlap (output)"),
+    Array("rev", "slot", "i", "i32", "dynamic", doc="reverse list: owner << bits | slot"),
+    Array("nbr_old", "slot", "i", "i32", "scratch", fill=-1, doc="half list before a rebuild"),
+    Array("hist_old", "slot", "H", "f", "scratch", doc="history before a rebuild"),
+    Array("cskip", "slot", "i", "i32", "scratch", doc="pair carried by PCMM elements"),
+    # wall slots
+    Array("wid", "wall_slot", "i", "i32", "dynamic", fill=-1, doc="candidate wall index"),
+    Array("whist", "wall_slot", "HW", "f", "dynamic", doc="wall contact history"),
+    Array("wcn", "wall_slot", 2, "f", "dynamic", doc="wall contact normal (output)"),
+    Array("wcf", "wall_slot", 4, "f", "dynamic", doc="wall contact force, moment (output)"),
+    Array("wcs", "wall_slot", 3, "f", "dynamic", doc="F_n, F_s, overlap (output)"),
+    Array("wid_old", "wall_slot", "i", "i32", "scratch", fill=-1, doc="before a rebuild"),
+    Array("whist_old", "wall_slot", "HW", "f", "scratch", doc="before a rebuild"),
+    # walls and tables
+    Array("wall", "table", ("walls", "wall_width"), "f64", "dynamic", doc="wall rows (step.W_*)"),
+    Array("wforce", "wall", 4, "f64", "dynamic", doc="fx, fy, moment, contacts received"),
+    Array("lawp", "table", ("laws", "law_width"), "f64", "scratch", doc="law parameters"),
+    Array("lawpair", "table", ("laws", "laws"), "i32", "scratch", doc="law of a pair of groups"),
+    Array("flags", "table", ("flags",), "i32", "dynamic", doc="status word (neighbors.F_*)"),
+    Array("simp", "table", ("simp",), "f64", "scratch", doc="engine parameters (step.P_*)"),
+    # neighbour grid
+    Array("cell_count", "table", ("cells",), "i32", "scratch", doc="particles per cell"),
+    Array("cell_start", "table", ("cell_starts",), "i32", "scratch", doc="prefix sums"),
+    Array("sorted", "particle", "i", "i32", "scratch", doc="particles by cell"),
+    Array("pcell", "particle", "i", "i32", "scratch", doc="cell of a particle"),
+    Array("gridp", "table", (4,), "f64", "setup", doc="grid origin, cell size"),
+    Array("gridn", "table", (4,), "i32", "setup", doc="grid cells per axis"),
+    Array("bounds", "table", (5,), "f64", "scratch", doc="bounding box of the particles"),
+)
+BY_NAME = {a.name: a for a in ENGINE}
+
+
+def dynamic():
+    """Names of the arrays a snapshot restores."""
+    return tuple(a.name for a in ENGINE if a.role == "dynamic")
+
+
+def saved():
+    """Names of the arrays a checkpoint saves."""
+    return tuple(a.name for a in ENGINE if a.role != "scratch")
+
+
+def _comps(a, laws):
+    if a.comps == "H":
+        return contact_law.pair_history_width(laws)
+    if a.comps == "HW":
+        return contact_law.wall_history_width(laws)
+    return a.comps
+
+
+def shape(a, sizes):
+    """Shape (and vector width, or None) of array ``a`` for ``sizes`` (a dict)."""
+    if a.owner == "table":
+        return tuple(sizes[s] if isinstance(s, str) else s for s in a.comps), None
+    lead = {"particle": ("n",), "slot": ("n", "cap"), "wall_slot": ("n", "capw"),
+            "wall": ("walls",)}[a.owner]
+    comps = _comps(a, sizes["laws_set"])
+    return tuple(sizes[s] for s in lead), (None if comps in (0, "i") else comps)
+
+
+def allocate(sizes, fdt, names=None):
+    """The device arrays for ``sizes`` (n, cap, capw, walls, laws, law_width, cells,
+    cell_starts, flags, simp, wall_width and laws_set, the registered law classes);
+    ``fdt`` the float type of "f" arrays."""
+    out = {}
+    for a in ENGINE:
+        if names is not None and a.name not in names:
+            continue
+        shp, vec = shape(a, sizes)
+        dt = {"f": fdt, "f64": ti.f64, "i32": ti.i32}[a.dtype]
+        out[a.name] = ti.Vector.ndarray(vec, dt, shp) if vec else ti.ndarray(dt, shp)
+    return out
+
+
+def fresh_rows(n, sizes, values):
+    """numpy rows for ``n`` new particles of every saved per-particle or per-slot array:
+    each array's fill, with ``values`` (a dict of arrays) where given."""
+    import numpy as np
+
+    rows = {}
+    for a in ENGINE:
+        if a.role == "scratch" or a.owner not in ("particle", "slot", "wall_slot"):
+            continue
+        shp, vec = shape(a, {**sizes, "n": n})
+        dt = np.int32 if a.dtype == "i32" else np.float64
+        rows[a.name] = (np.asarray(values[a.name], dtype=dt) if a.name in values else
+                        np.full(shp + ((vec,) if vec else ()), a.fill, dtype=dt))
+    return rows
+
+
+@cached
+@ti.kernel
+def _copy(src: ti.types.ndarray(), dst: ti.types.ndarray(), serial: ti.template()):
+    ti.loop_config(serialize=serial)
+    for I in ti.grouped(src):
+        dst[I] = src[I]
+
+
+def copy(src, dst, names, serial):
+    """dst[k] <- src[k] for the arrays ``names`` (one launch each, on the device)."""
+    for k in names:
+        _copy(src[k], dst[k], serial)
+
+
+def like(arr):
+    """A device array of the shape and type of ``arr``."""
+    if hasattr(arr, "n"):
+        return ti.Vector.ndarray(arr.n, arr.dtype, tuple(arr.shape))
+    return ti.ndarray(arr.dtype, tuple(arr.shape))
+
+
+def bind(kernel, arrays, **values):
+    """The positional arguments of ``kernel`` taken by name: each parameter from
+    ``values`` if given there, else from ``arrays`` (the state dict). A kernel thus
+    receives its arrays by the names it declares, never by position in a tuple."""
+    fn = getattr(kernel, "_primal", None) or kernel.kernel._primal
+    out = []
+    for arg in fn.arguments:
+        name = arg.name
+        if name in values:
+            out.append(values[name])
+        elif name in arrays:
+            out.append(arrays[name])
+        else:
+            raise KeyError(f"kernel {fn.func.__name__} takes {name!r}, which is neither a "
+                           f"state array nor given")
+    return tuple(out)
