@@ -39,7 +39,7 @@ Presets
 - ``paper``: R = 0.01 m (7701 particles), an elastic blade whose left-side nodes
   (the upper, back end of the plate) move right at 0.1 m/s (vy = 0), 27.5 s of
   cutting. The elastic steel blade sets the time step (about 1e-6 s): very long
-  (see the README); runnable, not meant for a test.
+  (see docs/cases.md); runnable, not meant for a test.
 - ``quick`` (about 1.5 minutes on 2 cores): R = 0.025 m (61 x 21 = 1281
   particles), a kinematic rigid blade (every node prescribed, so the steel does
   not limit the time step), a blade 5 x faster (0.5 m/s) and 1.2 s of cutting

@@ -1,6 +1,6 @@
 """tdem: continuum–discontinuum simulation in geomechanics, on Taichi.
 
-The public API (see README): :class:`Simulation`, the contact laws
+The public API (see docs/api.md): :class:`Simulation`, the contact laws
 :class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance` (and
 :class:`ContactLaw` with :func:`register_law` for laws of one's own), the
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the

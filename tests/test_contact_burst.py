@@ -58,7 +58,7 @@ def test_no_energy_from_nowhere_in_the_first_millisecond(first_ms):
 def test_whole_run_crater_and_energy(tmp_path):
     """3.6 ms: a crater wider than the charge and at least one layer of particles
     deep; still no energy from nowhere. (The measured crater is compared with the
-    paper's 1.4 m x 0.35 m in summary.json and the README.)"""
+    paper's 1.4 m x 0.35 m in summary.json and docs/cases.md.)"""
     s = contact_burst.run("quick", out=tmp_path)
     _energy_bound(s)
     assert s["crater_width_m"]["value"] > 2 * contact_burst.CHARGE_RADIUS
