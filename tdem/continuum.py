@@ -28,6 +28,7 @@ from physics.materials import JWL, MAT_WIDTH, Fluid
 
 from . import backend
 from .errors import CapacityError, InputError
+from .integrate import damped_leapfrog
 from .launch import cached
 from .mesh import nodal_masses
 from .neighbors import F_BUILDS
@@ -104,11 +105,9 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             m = nmass[v]
             v0 = nvel[v]
             f = nforce[v] + m * g
-            fd = -alpha_l * ti.abs(f) * ti.math.sign(v0)
-            den = 1.0 + 0.5 * alpha * dt
-            v1 = (v0 * (1.0 - 0.5 * alpha * dt) + (f + fd) / m * dt) / den
+            v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
             # the reaction balances the physical forces only (damping is not one)
-            vfree = (v0 * (1.0 - 0.5 * alpha * dt) + f / m * dt) / den
+            vfree, _ = damped_leapfrog(v0, f, m, alpha, 0.0, dt)
             fx = nfix[v]
             if fx & 1:
                 v1[0] = nvfix[v][0]
@@ -174,12 +173,8 @@ def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                 d = npos[q] - c
                 f += fq
                 mom += d[0] * fq[1] - d[1] * fq[0]
-            fd = -alpha_l * ti.abs(f) * ti.math.sign(v0)
-            md = -alpha_l * ti.abs(mom) * ti.math.sign(w0)
-            den = 1.0 + 0.5 * alpha * dt
-            num = 1.0 - 0.5 * alpha * dt
-            v1 = (v0 * num + (f + fd) / m * dt) / den
-            w1 = (w0 * num + (mom + md) / inertia * dt) / den
+            v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
+            w1, md = damped_leapfrog(w0, mom, inertia, alpha, alpha_l, dt)
             c1 = c + v1 * dt
             th = rstate[r, 4] + w1 * dt
             cs = ti.cos(th)
@@ -585,26 +580,42 @@ class Continuum:
             return getattr(self, "_crit_driven", math.inf)
         return self._crit
 
-    def before_forces(self, sim, dt, reach):
-        """Candidates (after a list build), PCMM update and block update of one step."""
-        a, e = self.a, sim._a
-        serial = sim._serial()
+    # ---------------------------------------------------- the stages of one step
+    # (the order is in Simulation._one_step; each stage owns what it writes)
+    def prescribed(self, sim):
+        """Stage: node velocities prescribed by functions of time, uploaded."""
         if self._fix_fn_nodes():
             self.apply_node_fixes(sim._time)
-        if self.has_pcmm:
-            pcmm.candidates(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
-                            e["cell_count"], e["cell_start"], e["sorted"], e["gridp"],
-                            e["gridn"], e["flags"], a["pflags"], F_BUILDS,
-                            float(sim.skin), int(reach))
-            # everything is rebuilt at the first two steps (cskip's first-step marks
-            # go at the second) and after a restore
-            pcmm.update(a, e, float(dt), float(sim._time), int(sim.steps == 0),
-                        self._full or sim.steps <= 1, self.carry_stress, self.eos, serial)
-            self._full = False
-        if self.nv:
-            blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
-                       a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
-                       float(dt), serial)
+
+    def pcmm_elements(self, sim, dt, reach):
+        """Stage: PCMM candidates (after a list build) and the element update, forces
+        into ``xforce`` (physics.pcmm)."""
+        if not self.has_pcmm:
+            return
+        a, e = self.a, sim._a
+        pcmm.candidates(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
+                        e["cell_count"], e["cell_start"], e["sorted"], e["gridp"],
+                        e["gridn"], e["flags"], a["pflags"], F_BUILDS,
+                        float(sim.skin), int(reach))
+        # everything is rebuilt at the first two steps (cskip's first-step marks
+        # go at the second) and after a restore
+        pcmm.update(a, e, float(dt), float(sim._time), int(sim.steps == 0),
+                    self._full or sim.steps <= 1, self.carry_stress, self.eos, sim._serial())
+        self._full = False
+
+    def block_stresses(self, sim, dt):
+        """Stage: block triangles' stresses and their nodal forces into ``nforce``."""
+        if not self.nv:
+            return
+        a = self.a
+        blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
+                   a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
+                   float(dt), sim._serial())
+
+    def point_edge(self, sim, dt):
+        """Stage: particle–block and block–block point–edge contacts (coupling/),
+        forces into ``xforce`` and ``nforce``."""
+        a, e = self.a, sim._a
         if self.nq["p"]:
             if not self.has_pcmm:
                 a["xforce"].fill(0.0)
@@ -620,6 +631,9 @@ class Continuum:
                           a["vsforce"], a["vsbroken"], a["nforce"], a["nforce"],
                           a["vgpar"], a["vgcnt"], a["vgedge"], float(dt))
 
+    def viscous_boundaries(self, sim):
+        """Stage: non-reflecting (viscous) boundary tractions into the same forces."""
+        a, e = self.a, sim._a
         for kind, vel, force in (("p", e.get("vel"), a["xforce"]), ("v", a["nvel"], a["nforce"])):
             nr = self.nr.get(kind, 0)
             if nr:
@@ -667,7 +681,8 @@ class Continuum:
     def _fix_fn_nodes(self):
         return self.nv and getattr(self, "_fix_fn", False)
 
-    def after_step(self, sim):
+    def integrate(self, sim):
+        """Stage: block nodes and rigid blocks move (tdem.integrate)."""
         if self.nv:
             a = self.a
             if self.nrigid:

@@ -1139,22 +1139,39 @@ class Simulation:
                            nwalls=len(self._walls_host), skin=float(self.skin))
 
     def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
-        """One step, the whole data flow (continua: see :mod:`tdem.continuum`)."""
+        """One time step: the stages in the order the data flows (Feng et al.'s seven
+        steps). Each stage owns what it writes:
+
+        1. prescribed velocities (functions of time) uploaded — ``vfix``, node fixes;
+        2. neighbour lists rebuilt when the skin check asked — slots and histories;
+        3. PCMM elements (physics.pcmm) — element stresses, ``xforce``;
+        4. blocks (physics.blocks) — triangle stresses, ``nforce``;
+        5. point–edge contacts (coupling) — ``xforce``, ``nforce``;
+        6. viscous (non-reflecting) boundaries — ``xforce``, ``nforce``;
+        7. DEM pairs and walls, gathered with ``xforce``, and the particles' damped
+           leapfrog (tdem.step, one kernel) — particle state, contacts, walls;
+        8. block nodes and rigid blocks integrated (tdem.integrate) — node state.
+        """
         cont = self._cont
-        if self._n:
-            if self._fix_fn:
-                self._apply_fixes(t=self._time)
-            # on a GPU the rebuild kernel runs every step and returns at once unless the
-            # device raised the flag; on the CPU the host reads the flag (shared memory)
-            if not host_reads_flag or self._a["flags"][F_REBUILD] != 0:
-                neighbors.rebuild(*rebuild_args)
+        dt = self._dt_run
+        if self._n and self._fix_fn:
+            self._apply_fixes(t=self._time)
         if cont is not None:
-            cont.before_forces(self, self._dt_run, self._reach)
+            cont.prescribed(self)
+        # on a GPU the rebuild kernel runs every step and returns at once unless the
+        # device raised the flag; on the CPU the host reads the flag (shared memory)
+        if self._n and (not host_reads_flag or self._a["flags"][F_REBUILD] != 0):
+            neighbors.rebuild(*rebuild_args)
+        if cont is not None:
+            cont.pcmm_elements(self, dt, self._reach)
+            cont.block_stresses(self, dt)
+            cont.point_edge(self, dt)
+            cont.viscous_boundaries(self)
         if self._n:
             stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set)
         if cont is not None:
-            cont.after_step(self)
-        self._time += self._dt_run
+            cont.integrate(self)
+        self._time += dt
         self._steps += 1
 
     def _take_snapshot(self):

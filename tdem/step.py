@@ -18,6 +18,7 @@ from physics.contact_law import (history_width, law_energy, law_force, law_stiff
                                  zero_history)
 from physics.rolling import rolling_couple, rolling_energy
 
+from .integrate import damped_leapfrog
 from .launch import cached
 from .neighbors import F_BAD, F_REBUILD, slot_bits
 
@@ -335,14 +336,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         v0 = vel[i]
         w0 = omega[i]
         ftot = f + m * g
-        # local non-viscous damping (Miyata Eq. 33, PFC form), per component
-        fd = -alpha_l * ti.abs(ftot) * ti.math.sign(v0)
-        md = -alpha_l * ti.abs(tq) * ti.math.sign(w0)
-        # global mass-proportional damping (C&S Eqs. 34–36)
-        den = 1.0 + 0.5 * alpha * dt
-        num = 1.0 - 0.5 * alpha * dt
-        v1 = (v0 * num + (ftot + fd) / m * dt) / den
-        w1 = (w0 * num + (tq + md) / inertia * dt) / den
+        # local and global damping, central differences (tdem.integrate)
+        v1, fd = damped_leapfrog(v0, ftot, m, alpha, alpha_l, dt)
+        w1, md = damped_leapfrog(w0, tq, inertia, alpha, alpha_l, dt)
         vfree = v1
         wfree = w1
         fx = fix[i]
