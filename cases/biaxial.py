@@ -19,7 +19,7 @@ resistance, 29.0°/23.0° for Model 1 and 26.5°/20.7° for Model 2 at delta = 0
 Decisions the paper leaves open
 -------------------------------
 - Specimen preparation: the paper uses multi-layer under-compaction (its ref. 58).
-  Here (``tdem.specimen.prepare``): discs on a loose lattice of the specimen's
+  Here (``cases._specimen.prepare``): discs on a loose lattice of the specimen's
   aspect ratio, walls closing in at a uniform strain rate to e = 0.31, then
   isotropic consolidation by four servo walls at the confining stress with the
   friction at 1.0, lowered step by step (x 0.7 each time) under the same stress
@@ -27,7 +27,7 @@ Decisions the paper leaves open
   the specimen follows from its discs and void ratio: about 180 x 305 mm (the
   paper: 180 x 306.7 mm), see the summary.
 - Grading: piecewise linear by area through d10, d50 = 7.6 mm and d60 = 1.3 d10
-  (``tdem.specimen.gradation``); the paper's Fig. 9 curve itself is not given.
+  (``cases._specimen.gradation``); the paper's Fig. 9 curve itself is not given.
 - Density 2650 kg/m³ (not given), no gravity, local damping 0.7 (the paper's
   damping is not given), time step 0.2 x the critical step.
 - Strain rate: the paper's 0.2 %/min would take ~10^10 steps. The compression
@@ -45,7 +45,7 @@ Decisions the paper leaves open
   reproducible.
 - The servo walls of the engine are proportional controllers, which lag behind a
   moving target; the side walls' target force gets an integral correction from the
-  host every 0.05 % of axial strain (``tdem.specimen.shear``), which keeps sigma_h
+  host every 0.05 % of axial strain (``cases._specimen.shear``), which keeps sigma_h
   within about 1 % (summary: ``sigma_h_hold``).
 - Peak: the largest sin(phi) of stresses averaged over 0.2 % axial strain.
   Residual: mean stresses over the last quarter of the test (axial strain from
@@ -165,8 +165,8 @@ def specimen_key(task):
 
 def prepare_specimen(task):
     """Prepare the specimen of ``task`` (a dict: n, confining, seed, threads, arch) and
-    return its checkpoint (:meth:`tdem.specimen.Specimen.save`) as bytes."""
-    from tdem import specimen
+    return its checkpoint (:meth:`cases._specimen.Specimen.save`) as bytes."""
+    from cases import _specimen as specimen
     n, confining, seed = specimen_key(task)
     spec = specimen.prepare(n=n, confining=confining, seed=seed, density=DENSITY,
                             threads=task.get("threads"), arch=task.get("arch"))
@@ -178,7 +178,7 @@ def prepare_specimen(task):
 
 def load_specimen(data, arch=None, keep=None):
     """A specimen from checkpoint bytes; ``keep``: also write them to this path."""
-    from tdem import specimen
+    from cases import _specimen as specimen
     if keep is not None:
         Path(keep).parent.mkdir(parents=True, exist_ok=True)
         Path(keep).write_bytes(data)
@@ -218,11 +218,11 @@ def run_test(task, output=None, vtu_snapshots=0, specimen_dir=None, spec=None):
     ``spec``: the specimen to compress (None: :func:`specimen_for` the task).
 
     Returns a dict: the task, the curves (numpy arrays), the friction angles
-    (:func:`tdem.specimen.friction_angles`), the specimen's state before compression,
+    (:func:`cases._specimen.friction_angles`), the specimen's state before compression,
     ``hold`` (:func:`sigma_h_hold`), the steps and the wall-clock time, and ``spec``
     (the specimen after compression, only with ``output``).
     """
-    from tdem import specimen
+    from cases import _specimen as specimen
     clock = common.Stopwatch()
     model, delta = check_material(task["model"], task["delta"])
     if spec is None:
@@ -408,7 +408,7 @@ def _label(name):
 
 def plot_fig11(results, png, confining):
     plt = common.pyplot()
-    from tdem.specimen import smooth
+    from cases._specimen import smooth
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
     for r in results:
         c = r["curves"]

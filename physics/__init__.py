@@ -3,6 +3,8 @@
 One law per file; each file holds the user-facing parameter class and the Taichi
 function the engine calls for one contact.
 """
+import tdem  # noqa: F401  (the engine first: these modules use its errors)
+
 from .contact_law import ContactLaw, register_law
 from .linear import LinearContact
 from .hertz_mindlin import HertzMindlin

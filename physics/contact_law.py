@@ -56,7 +56,7 @@ import taichi as ti
 
 from tdem.errors import InputError
 
-from .rolling import COL_ROLL_DAMP, COL_ROLL_DELTA, COL_ROLL_MODEL, RollingResistance
+from .rolling import COL_ROLL_DAMP, RollingResistance
 from .validate import non_negative
 
 # columns of a row of the law table (the rolling ones are physics.rolling's)

@@ -7,8 +7,11 @@ continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :cla
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
 :class:`InputError`, :class:`InstabilityError`.
 """
-from coupling import PointEdge
-from physics import ContactLaw, HertzMindlin, LinearContact, RollingResistance, register_law
+from coupling.point_edge import PointEdge
+from physics.contact_law import ContactLaw, register_law
+from physics.hertz_mindlin import HertzMindlin
+from physics.linear import LinearContact
+from physics.rolling import RollingResistance
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 
 from . import mesh, pack

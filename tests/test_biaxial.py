@@ -12,7 +12,7 @@ import pytest
 
 import tdem
 from cases import biaxial
-from tdem import specimen
+from cases import _specimen as specimen
 
 SIGMA = 200e3
 

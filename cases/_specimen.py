@@ -54,9 +54,9 @@ import numpy as np
 from physics import LinearContact, RollingResistance
 from physics.validate import in_range, non_negative, positive
 
-from .errors import InputError
-from .simulation import Simulation
-from .step import W_LAW
+from tdem.errors import InputError
+from tdem.simulation import Simulation
+from tdem.step import W_LAW
 
 #: The specimens of Jiang, Yu & Harris (2005), §5.
 PAPER = {
