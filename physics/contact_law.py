@@ -1,7 +1,7 @@
 """Contact laws: the base class, the registry, and the dispatch for one contact.
 
 A contact is computed in three parts (Yade's geometry → physics → law functors):
-the engine's geometry function of the shape pair (:mod:`tdem.step`) gives the overlap
+the geometry function of the shape pair (:mod:`physics.geometry`) gives the overlap
 ``u``, the normal and the relative velocity; the contact law turns them and the law's
 own history columns into forces, a tangent stiffness and the dissipated energy; the
 engine adds rolling resistance (:mod:`physics.rolling`) and accumulates the forces.
@@ -15,21 +15,30 @@ A law is a subclass of :class:`ContactLaw` in a file of its own (the built-in on
 - ``history``: the names of its history columns (kept per contact, carried across
   neighbour rebuilds, snapshots and checkpoints); the first is by convention the
   tangential spring force that the energy account and output read;
+- ``tangential``: the names in ``history`` that are vectors of the tangent plane
+  (``T`` columns each: 1 in 2D, where the tangent plane is the line along
+  t = n rotated +90°, and 3 in 3D); the other columns are scalars. The built-in laws
+  declare ``tangential = ("shear",)``;
 - ``force``, ``energy`` and ``stiffness``: Taichi functions (``@staticmethod`` + ``@ti.func``)::
 
-      force(q, u, vn, vs, meff, reff, dt, h) -> (fn_el, fn, fs, kn, cn, diss, h)
-      energy(q, u, reff, h) -> stored elastic energy (normal and tangential springs)
+      force(q, u, vn, vt, meff, reff, dt, h) -> (fn_el, fn, ft, kn, cn, diss, h)
+      energy(q, u, reff, h, T: ti.template()) -> stored elastic energy
       stiffness(q, u, reff) -> tangent normal stiffness k_n (for the rolling spring)
 
   with ``q`` the vector of the parameters in ``params`` order, ``u`` > 0 the overlap,
-  ``vn``, ``vs`` the relative velocity of the partner along the normal and the
-  tangent, ``meff`` the effective mass m* (m_i against a wall), ``reff`` the
-  effective radius R* (R_i against a wall), ``h`` the contact's history vector (the
-  law's columns are ``h[0] … h[len(history) − 1]``; it returns it updated). It
-  returns the elastic normal force ``fn_el`` and the total ``fn`` (both
-  compression-positive), the total tangential force ``fs``, the tangent normal
-  stiffness ``kn`` and normal dashpot ``cn`` (rolling resistance and the critical
-  time step use them) and the energy dissipated in the step.
+  ``vn`` the relative velocity of the partner along the normal and ``vt`` its
+  tangential part (a ``ti.Vector`` of ``T`` components, :mod:`physics.geometry.frame`),
+  ``meff`` the effective mass m* (m_i against a wall), ``reff`` the effective radius
+  R* (R_i against a wall), ``h`` the contact's history vector (the law's columns
+  first, in ``history`` order, a tangential one taking ``T`` columns; it returns it
+  updated). It returns the elastic normal force ``fn_el`` and the total ``fn`` (both
+  compression-positive), the total tangential force ``ft`` (a vector like ``vt``),
+  the tangent normal stiffness ``kn`` and normal dashpot ``cn`` (rolling resistance
+  and the critical time step use them) and the energy dissipated in the step.
+  :func:`get_columns` and :func:`put_columns` read and write a vector column. The
+  laws are thus written once for 2D and 3D: the engine's geometry function of the
+  shape pair gives ``n``, ``u`` and the relative velocity, and the frame functions
+  split it into ``vn`` and ``vt`` and turn ``ft`` back into a force.
 
 A law defined in a user's script is registered and used exactly like a built-in one
 (no edit of the package); kernels compiled before a registration are recompiled for
@@ -88,6 +97,10 @@ def register_law(cls):
             raise InputError(f"{name}.{attr} must be a tuple of column names, got {v!r}")
     if len(cls.history) < 1:
         raise InputError(f"{name}.history must name at least the tangential spring column")
+    tang = getattr(cls, "tangential", ())
+    if not isinstance(tang, tuple) or not set(tang) <= set(cls.history):
+        raise InputError(f"{name}.tangential must be a tuple of names in its history "
+                         f"{cls.history}, got {tang!r}")
     for attr in ("force", "energy", "stiffness"):
         if not callable(getattr(cls, attr, None)):
             raise InputError(f"{name}.{attr} must be a Taichi function (@staticmethod @ti.func)")
@@ -127,19 +140,34 @@ def law_class(name):
                          f"before loading") from None
 
 
-def history_width(laws):
+# components of a tangent-plane vector: 1 in 2D (along t), 3 in 3D
+TANGENT_2D = 1
+
+
+def history_columns(cls, tdim=TANGENT_2D):
+    """{name: (first column, width)} of a law class's history columns, a tangential one
+    ``tdim`` wide."""
+    out, c = {}, 0
+    for name in cls.history:
+        w = tdim if name in getattr(cls, "tangential", ()) else 1
+        out[name] = (c, w)
+        c += w
+    return out
+
+
+def history_width(laws, tdim=TANGENT_2D):
     """Number of history columns the laws of ``laws`` own (the widest)."""
-    return max(len(c.history) for c in laws)
+    return max(sum(w for _, w in history_columns(c, tdim).values()) for c in laws)
 
 
-def pair_history_width(laws):
+def pair_history_width(laws, tdim=TANGENT_2D):
     """Width of a particle pair's history vector: law columns, rolling, u0."""
-    return history_width(laws) + len(ROLLING_COLUMNS) + 1
+    return history_width(laws, tdim) + len(ROLLING_COLUMNS) + 1
 
 
-def wall_history_width(laws):
+def wall_history_width(laws, tdim=TANGENT_2D):
     """Width of a particle–wall history vector: law columns, rolling."""
-    return history_width(laws) + len(ROLLING_COLUMNS)
+    return history_width(laws, tdim) + len(ROLLING_COLUMNS)
 
 
 def table_width(laws):
@@ -152,6 +180,7 @@ class ContactLaw:
 
     params = ()
     history = ()
+    tangential = ()
     rolling = None
 
     def values(self):
@@ -247,44 +276,77 @@ class ContactLaw:
 
 # ------------------------------------------------------------- shared pieces of laws
 @ti.func
-def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt, fs_old):
-    """Coulomb limit |F_s| <= F_n tan(phi) + c (C&S Eq. 19), keeping the sign.
+def get_columns(h, first: ti.template(), width: ti.template()):
+    """Columns first … first + width − 1 of the history vector h, as a vector."""
+    return ti.Vector([h[first + c] for c in ti.static(range(width))])
 
-    Returns (spring force kept, total shear force, dissipated energy). The shear
-    dashpot is off while sliding (C&S). The slip energy is the mean of the old and
-    new shear force times the slip increment (F_trial − F_s)/k_s, which is what the
-    central-difference step does on the spring (with F_max alone the account loses
-    an O(Δt) share whenever F_n changes while sliding).
+
+@ti.func
+def put_columns(h, first: ti.template(), v):
+    """h with the vector v written into its columns from ``first``; returns h."""
+    for c in ti.static(range(v.n)):
+        h[first + c] = v[c]
+    return h
+
+
+@ti.func
+def coulomb_shear(fs_trial, fn_el, mu, coh, ks, cs, vs, dt, fs_old):
+    """Coulomb limit |F_s| <= F_n tan(phi) + c (C&S Eq. 19), keeping the direction.
+
+    ``fs_trial``, ``vs`` and ``fs_old`` are tangent-plane vectors (one component in
+    2D, three in 3D). Returns (spring force kept, total shear force, dissipated
+    energy). The shear dashpot is off while sliding (C&S). The slip energy is the
+    mean of the old and new shear force times the slip increment (F_trial − F_s)/k_s,
+    which is what the central-difference step does on the spring (with F_max alone
+    the account loses an O(Δt) share whenever F_n changes while sliding).
     """
     fmax = ti.max(fn_el * mu + coh, 0.0)
     fs = fs_trial
-    fs_tot = 0.0
+    fs_tot = fs_trial * 0.0
     diss = 0.0
-    if ti.abs(fs_trial) > fmax:
-        fs = ti.math.sign(fs_trial) * fmax
+    mag = 0.0
+    if ti.static(fs_trial.n == 1):
+        mag = ti.abs(fs_trial[0])
+    else:
+        mag = fs_trial.norm()
+    if mag > fmax:
+        if ti.static(fs_trial.n == 1):
+            fs = ti.Vector([ti.math.sign(fs_trial[0]) * fmax])
+        else:
+            fs = fs_trial * (fmax / mag)
         fs_tot = fs
         if ks > 0.0:
-            diss = 0.5 * (fs_old + fs) * (fs_trial - fs) / ks
+            diss = (0.5 * (fs_old + fs)).dot(fs_trial - fs) / ks
     else:
         fs_tot = fs + cs * vs
-        diss = cs * vs * vs * dt
+        diss = (cs * vs).dot(vs) * dt
     return fs, fs_tot, diss
 
 
 @ti.func
 def spring_dashpot(fn_el, kn, ks, beta, gamma, u, vn, vs, meff, mu, coh, dt, h):
     """Normal dashpot c_n = β k_n + γ_e sqrt(k_n m*) and the incremental Coulomb
-    shear spring in h[0], shared by the linear and Hertz–Mindlin laws. Returns the
-    tuple of :meth:`ContactLaw.force`."""
+    shear spring (a tangent-plane vector in the history's first columns), shared by
+    the linear and Hertz–Mindlin laws. Returns the tuple of :meth:`ContactLaw.force`."""
     cn = beta * kn + gamma * ti.sqrt(kn * meff)
     cs = beta * ks
     fn = fn_el - cn * vn
-    fs_old = h[0]
+    fs_old = get_columns(h, 0, ti.static(vs.n))
     fs, fs_tot, diss = coulomb_shear(fs_old + ks * vs * dt, fn_el, mu, coh, ks, cs, vs, dt,
                                      fs_old)
     diss += cn * vn * vn * dt
-    h[0] = fs
+    h = put_columns(h, 0, fs)
     return fn_el, fn, fs_tot, kn, cn, diss, h
+
+
+@ti.func
+def shear_spring_energy(h, ks, T: ti.template()):
+    """0.5 |F_s|²/k_s of the shear spring in the history's first T columns."""
+    e = 0.0
+    if ks > 0.0:
+        fs = get_columns(h, 0, T)
+        e = 0.5 * fs.dot(fs) / ks
+    return e
 
 
 # ------------------------------------------------------------------- dispatch
@@ -294,14 +356,15 @@ def _params(laws: ti.template(), c: ti.template(), lawp: ti.template(), L):
 
 
 @ti.func
-def law_force(laws: ti.template(), lawp: ti.template(), L, u, vn, vs, meff, reff, dt, h):
+def law_force(laws: ti.template(), lawp: ti.template(), L, u, vn, vt, meff, reff, dt, h):
     """Forces of one contact by the law of row L of the table (module docstring), in
-    the contact's frame (n from i to j, t = n rotated +90°). Returns
-    (F_n elastic, F_n total, F_s total, tangent k_n, c_n, dissipation, history)."""
+    the contact's frame (n from i to j; vt in the tangent plane). Returns
+    (F_n elastic, F_n total, F_t total (a vector like vt), tangent k_n, c_n,
+    dissipation, history)."""
     code = ti.cast(lawp[L, COL_CODE], ti.i32)
     fn_el = 0.0
     fn = 0.0
-    fs_tot = 0.0
+    fs_tot = vt * 0.0
     kn = 0.0
     cn = 0.0
     diss = 0.0
@@ -310,19 +373,20 @@ def law_force(laws: ti.template(), lawp: ti.template(), L, u, vn, vs, meff, reff
         if code == c:
             q = _params(laws, c, lawp, L)
             fn_el, fn, fs_tot, kn, cn, diss, hout = ti.static(laws[c].force)(
-                q, u, vn, vs, meff, reff, dt, h)
+                q, u, vn, vt, meff, reff, dt, h)
     return fn_el, fn, fs_tot, kn, cn, diss, hout
 
 
 @ti.func
-def law_energy(laws: ti.template(), lawp: ti.template(), L, u, reff, h):
-    """Energy stored in the normal and tangential springs of one contact."""
+def law_energy(laws: ti.template(), lawp: ti.template(), L, u, reff, h, T: ti.template()):
+    """Energy stored in the normal and tangential springs of one contact (T: the
+    components of a tangent-plane vector)."""
     code = ti.cast(lawp[L, COL_CODE], ti.i32)
     e = 0.0
     for c in ti.static(range(len(laws))):
         if code == c:
             q = _params(laws, c, lawp, L)
-            e = ti.static(laws[c].energy)(q, u, reff, h)
+            e = ti.static(laws[c].energy)(q, u, reff, h, T)
     return e
 
 

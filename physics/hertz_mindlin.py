@@ -15,7 +15,7 @@ Miyata Eq. 17 evaluated with the current tangent stiffness.
 import numpy as np
 import taichi as ti
 
-from .contact_law import ContactLaw, register_law, spring_dashpot
+from .contact_law import ContactLaw, register_law, shear_spring_energy, spring_dashpot
 from .validate import in_range, positive
 
 
@@ -25,6 +25,7 @@ class HertzMindlin(ContactLaw):
 
     params = ("e_star", "g_star", "friction", "cohesion", "damping_ratio", "_gamma")
     history = ("shear",)
+    tangential = ("shear",)
 
     def __init__(self, young, poisson, friction=0.5, restitution=None, cohesion=0.0,
                  damping_ratio=0.0, rolling=None):
@@ -43,21 +44,17 @@ class HertzMindlin(ContactLaw):
 
     @staticmethod
     @ti.func
-    def force(q, u, vn, vs, meff, reff, dt, h):
+    def force(q, u, vn, vt, meff, reff, dt, h):
         # Hertz (Miyata Eqs. 24, 27, 31): a = sqrt(R* u)
         a = ti.sqrt(reff * u)
         return spring_dashpot(4.0 / 3.0 * q[0] * a * u, 2.0 * q[0] * a, 8.0 * q[1] * a,
-                              q[4], q[5], u, vn, vs, meff, q[2], q[3], dt, h)
+                              q[4], q[5], u, vn, vt, meff, q[2], q[3], dt, h)
 
     @staticmethod
     @ti.func
-    def energy(q, u, reff, h):
+    def energy(q, u, reff, h, T: ti.template()):
         a = ti.sqrt(reff * u)
-        ks = 8.0 * q[1] * a
-        e = 0.4 * (4.0 / 3.0 * q[0] * a * u) * u
-        if ks > 0.0:
-            e += 0.5 * h[0] * h[0] / ks
-        return e
+        return 0.4 * (4.0 / 3.0 * q[0] * a * u) * u + shear_spring_energy(h, 8.0 * q[1] * a, T)
 
     @staticmethod
     @ti.func

@@ -15,12 +15,11 @@ import taichi as ti
 
 from tdem.errors import InputError
 
-from .contact_law import ContactLaw, register_law, spring_dashpot
+from .contact_law import ContactLaw, register_law, shear_spring_energy, spring_dashpot
 from .validate import positive
 
 
 @register_law
-
 class LinearContact(ContactLaw):
     """Linear spring–dashpot contact with Coulomb friction.
 
@@ -42,6 +41,7 @@ class LinearContact(ContactLaw):
 
     params = ("kn", "ks", "friction", "cohesion", "damping_ratio", "_gamma")
     history = ("shear",)
+    tangential = ("shear",)
 
     def __init__(self, kn, ks=None, friction=0.5, cohesion=0.0, restitution=None,
                  damping_ratio=0.0, rolling=None):
@@ -61,17 +61,14 @@ class LinearContact(ContactLaw):
 
     @staticmethod
     @ti.func
-    def force(q, u, vn, vs, meff, reff, dt, h):
+    def force(q, u, vn, vt, meff, reff, dt, h):
         kn = q[0]
-        return spring_dashpot(kn * u, kn, q[1], q[4], q[5], u, vn, vs, meff, q[2], q[3], dt, h)
+        return spring_dashpot(kn * u, kn, q[1], q[4], q[5], u, vn, vt, meff, q[2], q[3], dt, h)
 
     @staticmethod
     @ti.func
-    def energy(q, u, reff, h):
-        e = 0.5 * q[0] * u * u
-        if q[1] > 0.0:
-            e += 0.5 * h[0] * h[0] / q[1]
-        return e
+    def energy(q, u, reff, h, T: ti.template()):
+        return 0.5 * q[0] * u * u + shear_spring_energy(h, q[1], T)
 
     @staticmethod
     @ti.func

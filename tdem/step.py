@@ -14,8 +14,10 @@ Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
 """
 import taichi as ti
 
-from physics.contact_law import (history_width, law_energy, law_force, law_stiffness,
-                                 zero_history)
+from physics.contact_law import (TANGENT_2D, history_width, law_energy, law_force,
+                                 law_stiffness, zero_history)
+from physics.geometry import disc_disc, disc_segment
+from physics.geometry.frame import perp, tangent_part, tangent_vector
 from physics.rolling import rolling_couple, rolling_energy
 
 from .integrate import damped_leapfrog
@@ -37,19 +39,6 @@ FIX_VX, FIX_VY, FIX_W = 1, 2, 4
 
 
 @ti.func
-def perp(n):
-    return ti.Vector([-n[1], n[0]])
-
-
-@ti.func
-def closest_on_segment(x, a, b, inv_ll):
-    """Closest point to x on segment ab; inv_ll = 1/|b − a|² (rotation keeps it)."""
-    ab = b - a
-    s = ti.math.clamp((x - a).dot(ab) * inv_ll, 0.0, 1.0)
-    return a + s * ab
-
-
-@ti.func
 def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template(),
                  omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                  lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
@@ -67,13 +56,11 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     R = ti.static(history_width(laws))
     U0 = ti.static(R + 3)
     j = nbr[i, k]
-    d = pos[j] - xi
-    dist = d.norm()
     pj = prop[j]
     rj = pj[0]
-    u_geo = ri + rj - dist
+    d, dist, u_geo = disc_disc.overlap(xi, pos[j], ri, rj)
     # a pair that shared PCMM elements until recently counts its overlap from the
-    # overlap it had when they stopped carrying it (hist[4], recorded by
+    # overlap it had when they stopped carrying it (hist[U0], recorded by
     # physics.pcmm.gather, lowered as the two separate): the contact law takes over
     # from the elements without a force jump (no energy from nowhere)
     h = hist[i, k]
@@ -84,24 +71,18 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     m_on_j = 0.0
     diss = 0.0
     if u > 0.0:
-        n = ti.Vector([1.0, 0.0])
-        if dist > 0.0:
-            n = d * (1.0 / dist)
-        t = perp(n)
-        ai = ri - 0.5 * u
-        aj = rj - 0.5 * u
         wj = omega[j]
-        vrel = vel[j] - vi - (wj * aj + wi * ai) * t
+        n, t, ai, aj, vrel = disc_disc.kinematics(d, dist, u, ri, rj, vi, vel[j], wi, wj)
         vn = vrel.dot(n)
-        vs = vrel.dot(t)
         L = lawpair[li, plaw[j]]
         mj = pj[1]
         reff = ri * rj / (ri + rj)
-        fn_el, fn, fs_tot, kn, cnd, d1, h = law_force(
-            laws, lawp, L, u, vn, vs, mi * mj / (mi + mj), reff, dt, h)
+        fn_el, fn, ft, kn, cnd, d1, h = law_force(
+            laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h)
+        fs_tot = ft[0]
         m, m_tot, th, brk, d2 = rolling_couple(
             lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
-        f = -fn * n + fs_tot * t
+        f = -fn * n + tangent_vector(ft, n)
         m_on_i = ai * fs_tot + m_tot
         m_on_j = aj * fs_tot - m_tot
         h[R] = m
@@ -145,30 +126,22 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             break
         a = ti.Vector([wall[w, W_X0], wall[w, W_Y0]])
         b = ti.Vector([wall[w, W_X1], wall[w, W_Y1]])
-        d = closest_on_segment(xi, a, b, wall[w, W_INVLL]) - xi
-        d2 = d.dot(d)
+        d, d2 = disc_segment.overlap(xi, a, b, wall[w, W_INVLL])
         if d2 < ri * ri:
-            dist = ti.sqrt(d2)
-            u = ri - dist
-            n = ti.Vector([1.0, 0.0])
-            if dist > 0.0:
-                n = d / dist
-            t = perp(n)
-            ai = ri - 0.5 * u
-            xc = xi + ai * n
             c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
             ww = wall[w, W_OMEGA]
-            vw = ti.Vector([wall[w, W_VX], wall[w, W_VY]]) + ww * perp(xc - c)
-            vrel = vw - vel[i] - omega[i] * ai * t
+            u, n, t, ai, xc, vw, vrel = disc_segment.kinematics(
+                xi, d, d2, ri, vel[i], omega[i], ti.Vector([wall[w, W_VX], wall[w, W_VY]]),
+                ww, c)
             vn = vrel.dot(n)
-            vs = vrel.dot(t)
             L = ti.cast(wall[w, W_LAW], ti.i32)
             h = whist[i, s]
-            fn_el, fn, fs_tot, kn, cnd, d1, h = law_force(
-                laws, lawp, L, u, vn, vs, prop[i][1], ri, dt, h)
+            fn_el, fn, ft, kn, cnd, d1, h = law_force(
+                laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][1], ri, dt, h)
+            fs_tot = ft[0]
             m, m_tot, th, brk, d2r = rolling_couple(
                 lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[R], h[R + 1], h[R + 2])
-            f = -fn * n + fs_tot * t
+            f = -fn * n + tangent_vector(ft, n)
             mi = ai * fs_tot + m_tot
             h[R] = m
             h[R + 1] = th
@@ -281,7 +254,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     j = nbr[i, k]
                     u = pi[0] + prop[j][0] - (pos[j] - xi).norm()
                     h0 = hist[i, k]
-                    h0[4] = ti.max(u, 0.0)
+                    h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
                     hist[i, k] = h0
                 fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel,
                                                omega, prop, plaw, lawp, lawpair, nbr, hist, cn,
@@ -441,7 +414,7 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                 h = hist[i, k]
                 reff = ri * rj / (ri + rj)
                 kn = law_stiffness(laws, lawp, L, u, reff)
-                total += law_energy(laws, lawp, L, u, reff, h) + rolling_energy(
+                total += law_energy(laws, lawp, L, u, reff, h, TANGENT_2D) + rolling_energy(
                     lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
         for s in range(wid.shape[1]):
             w = wid[i, s]
@@ -451,7 +424,7 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                     h = whist[i, s]
                     L = ti.cast(wall[w, W_LAW], ti.i32)
                     kn = law_stiffness(laws, lawp, L, u, ri)
-                    total += law_energy(laws, lawp, L, u, ri, h) + rolling_energy(
+                    total += law_energy(laws, lawp, L, u, ri, h, TANGENT_2D) + rolling_energy(
                         lawp, L, kn, h[R], 2.0 * ri)
     return total
 

@@ -14,7 +14,7 @@ import pytest
 import taichi as ti
 
 import tdem
-from physics.contact_law import coulomb_shear, unregister_law
+from physics.contact_law import coulomb_shear, get_columns, put_columns, unregister_law
 
 
 class MyLinear(tdem.ContactLaw):
@@ -22,6 +22,7 @@ class MyLinear(tdem.ContactLaw):
 
     params = ("kn", "ks", "friction", "beta", "gamma")
     history = ("shear",)
+    tangential = ("shear",)
 
     def __init__(self, kn, ks, friction, restitution, rolling=None):
         self.kn, self.ks, self.friction, self.restitution = kn, ks, friction, restitution
@@ -42,23 +43,25 @@ class MyLinear(tdem.ContactLaw):
 
     @staticmethod
     @ti.func
-    def force(q, u, vn, vs, meff, reff, dt, h):
+    def force(q, u, vn, vt, meff, reff, dt, h):
         kn, ks, mu = q[0], q[1], q[2]
         fn_el = kn * u
         cn = q[3] * kn + q[4] * ti.sqrt(kn * meff)
         fn = fn_el - cn * vn
-        fs, fs_tot, diss = coulomb_shear(h[0] + ks * vs * dt, fn_el, mu, 0.0, ks, q[3] * ks,
-                                         vs, dt, h[0])
+        fs_old = get_columns(h, 0, ti.static(vt.n))
+        fs, fs_tot, diss = coulomb_shear(fs_old + ks * vt * dt, fn_el, mu, 0.0, ks,
+                                         q[3] * ks, vt, dt, fs_old)
         diss += cn * vn * vn * dt
-        h[0] = fs
+        h = put_columns(h, 0, fs)
         return fn_el, fn, fs_tot, kn, cn, diss, h
 
     @staticmethod
     @ti.func
-    def energy(q, u, reff, h):
+    def energy(q, u, reff, h, T: ti.template()):
         e = 0.5 * q[0] * u * u
         if q[1] > 0.0:
-            e += 0.5 * h[0] * h[0] / q[1]
+            fs = get_columns(h, 0, T)
+            e += 0.5 * fs.dot(fs) / q[1]
         return e
 
     @staticmethod
@@ -72,7 +75,7 @@ class WaltonBraun(tdem.ContactLaw):
     from the largest overlap u_max (u0 = u_max (1 − k1/k2)); frictionless."""
 
     params = ("k1", "k2")
-    history = ("shear", "max_overlap")
+    history = ("shear", "max_overlap")     # frictionless: "shear" stays a scalar 0
 
     def __init__(self, k1, k2):
         self.k1, self.k2 = float(k1), float(k2)
@@ -82,7 +85,7 @@ class WaltonBraun(tdem.ContactLaw):
 
     @staticmethod
     @ti.func
-    def force(q, u, vn, vs, meff, reff, dt, h):
+    def force(q, u, vn, vt, meff, reff, dt, h):
         k1, k2 = q[0], q[1]
         umax = h[1]
         diss = 0.0
@@ -95,11 +98,11 @@ class WaltonBraun(tdem.ContactLaw):
         if u >= umax:
             kn = k1
         h[1] = umax
-        return fn, fn, 0.0, kn, 0.0, diss, h
+        return fn, fn, vt * 0.0, kn, 0.0, diss, h
 
     @staticmethod
     @ti.func
-    def energy(q, u, reff, h):
+    def energy(q, u, reff, h, T: ti.template()):
         d = ti.max(u - h[1] * (1.0 - q[0] / q[1]), 0.0)
         return 0.5 * q[1] * d * d
 
