@@ -32,6 +32,7 @@ from .integrate import damped_leapfrog
 from .launch import cached
 from .mesh import nodal_masses
 from .neighbors import F_BUILDS
+from . import state as schema
 from .step import FIX_VX, FIX_VY, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY
 
 MAX_CANDIDATES = 1024
@@ -195,7 +196,7 @@ def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
 def _arr(spec, shape, dtype=ti.f64):
     if spec == 0:
         return ti.ndarray(dtype, shape)
-    return ti.Vector.ndarray(spec, dtype, shape)
+    return schema.ndarray(spec, dtype, shape)
 
 
 class Continuum:
@@ -384,7 +385,7 @@ class Continuum:
                         ("nvfix", 2), ("nmass", 0), ("nsize", 0)):
             a[k] = _arr(spec, (nv,))
         a["nfix"] = ti.ndarray(ti.i32, (nv,))
-        a["tri"] = ti.Vector.ndarray(3, ti.i32, (nt,))
+        a["tri"] = schema.ndarray(3, ti.i32, (nt,))
         a["tmat"] = ti.ndarray(ti.i32, (nt,))
         a["tsig"] = _arr(4, (nt,))
         a["tstate"] = _arr(4, (nt,))
@@ -729,7 +730,7 @@ class Continuum:
             src = self.a[k]
             dst = self.snap.get(k)
             if dst is None or tuple(dst.shape) != tuple(src.shape):
-                dst = self.snap[k] = (ti.Vector.ndarray(src.n, src.dtype, tuple(src.shape))
+                dst = self.snap[k] = (schema.ndarray(src.n, src.dtype, tuple(src.shape))
                                       if hasattr(src, "n") else
                                       ti.ndarray(src.dtype, tuple(src.shape)))
             if k not in _SNAP_PARTICLES:

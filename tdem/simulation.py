@@ -1110,7 +1110,7 @@ class Simulation:
             return self._cont.a["xforce"]
         x = self._a.get("xforce_none")
         if x is None:
-            x = self._a["xforce_none"] = ti.Vector.ndarray(2, ti.f64, (1,))
+            x = self._a["xforce_none"] = schema.ndarray(2, ti.f64, (1,))
         return x
 
 

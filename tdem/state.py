@@ -23,9 +23,11 @@ or a wall contact's history vector (as wide as the registered contact laws need,
 :mod:`tdem.continuum` keeps the PCMM, block and coupling arrays in the same way
 (``Continuum.a``, its snapshot list).
 """
+import weakref
 from dataclasses import dataclass
 
 import taichi as ti
+from taichi.lang import impl
 
 from physics import contact_law
 
@@ -139,8 +141,29 @@ def allocate(sizes, fdt, names=None):
             continue
         shp, vec = shape(a, sizes)
         dt = {"f": fdt, "f64": ti.f64, "i32": ti.i32}[a.dtype]
-        out[a.name] = ti.Vector.ndarray(vec, dt, shp) if vec else ti.ndarray(dt, shp)
+        out[a.name] = ndarray(vec, dt, shp)
     return out
+
+
+def _delete(prog, handle):
+    # only the Taichi program that made the array may free it (a reset made a new one)
+    rt = impl.get_runtime()
+    if rt is not None and rt.prog is prog:
+        prog.delete_ndarray(handle)
+
+
+def ndarray(vec, dtype, shape):
+    """A device array: of ``vec``-vectors (``vec`` > 0) or scalars (``vec`` 0 or None).
+
+    Taichi 1.7 frees a scalar ndarray when it is garbage-collected but never a vector
+    or matrix one (taichi-dev/taichi#8763): every model built and dropped, and every
+    growth of its slots, would keep its memory until the process ends. A vector array
+    made here gets the release that scalar ones have."""
+    if not vec:
+        return ti.ndarray(dtype, tuple(shape))
+    arr = ti.Vector.ndarray(vec, dtype, tuple(shape))
+    weakref.finalize(arr, _delete, impl.get_runtime().prog, arr.arr)
+    return arr
 
 
 def fresh_rows(n, sizes, values):
@@ -175,9 +198,7 @@ def copy(src, dst, names, serial):
 
 def like(arr):
     """A device array of the shape and type of ``arr``."""
-    if hasattr(arr, "n"):
-        return ti.Vector.ndarray(arr.n, arr.dtype, tuple(arr.shape))
-    return ti.ndarray(arr.dtype, tuple(arr.shape))
+    return ndarray(getattr(arr, "n", None), arr.dtype, arr.shape)
 
 
 def bind(kernel, arrays, **values):
