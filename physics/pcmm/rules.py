@@ -95,10 +95,10 @@ from tdem import backend
 from tdem.errors import CapacityError, InputError
 from tdem.launch import cached
 
-from . import fvm
-from .contact_law import zero_history
-from .materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
-from .validate import positive
+from .. import fvm
+from ..contact_law import zero_history
+from ..materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
+from ..validate import positive
 
 MAX_ELEMENTS = 12        # elements a particle can create (pruned gaps are >= 30 deg)
 MAX_CAPACITY = 1024      # largest Eq. 1 neighbour capacity ElementSystem grows to
