@@ -1,7 +1,10 @@
-"""Physical laws: DEM contact laws and rolling resistance.
+"""Physical laws: DEM contact laws and rolling resistance, and the continuum.
 
 One law per file; each file holds the user-facing parameter class and the Taichi
-function the engine calls for one contact.
+function the engine calls for one contact. The continuum: :mod:`physics.pcmm` (the
+PCMM element system, a package: ``rules.py``, ``system.py``, ``rebuild.py``,
+``stress.py``, ``nodal.py``, ``step.py``, ``layout.py``), :mod:`physics.fvm` (the
+triangle stress update), :mod:`physics.materials` and :mod:`physics.blocks`.
 """
 import tdem  # noqa: F401  (the engine first: these modules use its errors)
 

@@ -6,15 +6,15 @@ One step of a model with continua (:meth:`tdem.Simulation._one_step`):
       -> PCMM candidates (only after a list build)            physics.pcmm.candidates
       -> PCMM elements, stresses, nodal forces, gathered     physics.pcmm.update
          (displacements -> rebuild_elements -> mark_dirty -> copies -> incidence
-          -> stresses -> equation_of_state -> gather)
+          -> record_slots -> stresses -> equation_of_state -> gather)
       -> block element stresses and nodal forces            physics.blocks.update
       -> DEM contacts + element forces, leapfrog           tdem.step.step
-      -> block nodes: damping, prescribed velocities, leapfrog   integrate_nodes
+      -> block nodes: damping, prescribed velocities, leapfrog   tdem.nodes
 
 PCMM particles are particles of the engine (they move, collide and are output
 with the others); what is added here is their element system and stress state.
-Block nodes are not particles: they have their own arrays and integrator, and
-blocks are output as meshes.
+Block nodes are not particles: they have their own arrays and integrator
+(:mod:`tdem.nodes`), and blocks are output as meshes.
 """
 import math
 
@@ -28,15 +28,14 @@ from physics.materials import JWL, MAT_WIDTH, Fluid
 
 from . import backend
 from .errors import CapacityError, InputError
-from .integrate import damped_leapfrog
 from .launch import cached
 from .mesh import nodal_masses
 from .neighbors import F_BUILDS
 from . import state as schema
-from .step import FIX_VX, FIX_VY, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY
+from .nodes import RIGID_NODE, integrate_nodes, integrate_rigid, viscous_boundary
+from .step import FIX_VX, FIX_VY
 
 MAX_CANDIDATES = 1024
-RIGID_NODE = 8          # node flag: the node belongs to a free rigid block
 
 # the restore point of a run segment (the dynamic state): the per-particle arrays
 # below are copied by one kernel (:func:`copy_particles`, in this order), the others
@@ -78,119 +77,6 @@ def copy_particles(a0: ti.types.ndarray(), a1: ti.types.ndarray(), a2: ti.types.
             b8[i, s, 0] = a8[i, s, 0]
             b8[i, s, 1] = a8[i, s, 1]
             b9[i, s] = a9[i, s]
-
-
-@cached
-@ti.kernel
-def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
-                    nmass: ti.types.ndarray(), nforce: ti.types.ndarray(),
-                    nfix: ti.types.ndarray(), nvfix: ti.types.ndarray(),
-                    nsize: ti.types.ndarray(), nreact: ti.types.ndarray(),
-                    simp: ti.types.ndarray(), nflags: ti.types.ndarray(),
-                    serial: ti.template()):
-    """Block nodes, as the particles in :func:`tdem.step.step`: gravity, local and
-    global damping, prescribed velocity components (``nreact`` = the force the
-    constraint applies), leapfrog. nflags[0] = smallest index of a node with a
-    non-finite state or moving more than half its size in one step."""
-    dt = simp[P_DT]
-    g = ti.Vector([simp[P_GX], simp[P_GY]])
-    alpha = simp[P_ALPHA]
-    alpha_l = simp[P_ALPHA_LOCAL]
-    nv = npos.shape[0]
-    ti.loop_config(serialize=True)
-    for _ in range(1):
-        nflags[0] = nv
-    ti.loop_config(serialize=serial)
-    for v in range(nv):
-        if (nfix[v] & RIGID_NODE) == 0:   # nodes of rigid blocks move with their body
-            m = nmass[v]
-            v0 = nvel[v]
-            f = nforce[v] + m * g
-            v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
-            # the reaction balances the physical forces only (damping is not one)
-            vfree, _ = damped_leapfrog(v0, f, m, alpha, 0.0, dt)
-            fx = nfix[v]
-            if fx & 1:
-                v1[0] = nvfix[v][0]
-            if fx & 2:
-                v1[1] = nvfix[v][1]
-            nreact[v] = m * (v1 - vfree) / dt
-            x1 = npos[v] + v1 * dt
-            nvel[v] = v1
-            npos[v] = x1
-            s = x1[0] + x1[1] + v1[0] + v1[1]
-            bad = not (s == s) or ti.abs(s) > 1e300
-            if not bad:
-                bad = v1.norm() * dt > 0.5 * nsize[v]
-            if bad:
-                ti.atomic_min(nflags[0], v)
-
-
-@cached
-@ti.kernel
-def viscous_boundary(vel: ti.types.ndarray(), force: ti.types.ndarray(),
-                     ids: ti.types.ndarray(), coef: ti.types.ndarray()):
-    """Non-reflecting (Lysmer–Kuhlemeyer) boundary: on point ids[r] with outward unit
-    normal n = coef[r, 0:2] and dashpots a_n = A·ρ·c_p, a_s = A·ρ·c_s in coef[r, 2:4],
-    the traction −a_n (v·n) n − a_s (v·t) t is added to ``force``."""
-    for r in range(ids.shape[0]):
-        i = ids[r]
-        n = ti.Vector([coef[r, 0], coef[r, 1]])
-        t = ti.Vector([-n[1], n[0]])
-        v = vel[i]
-        f = -coef[r, 2] * v.dot(n) * n - coef[r, 3] * v.dot(t) * t
-        ti.atomic_add(force[i][0], f[0])
-        ti.atomic_add(force[i][1], f[1])
-
-
-@cached
-@ti.kernel
-def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
-                    nforce: ti.types.ndarray(), nmass: ti.types.ndarray(),
-                    rbody: ti.types.ndarray(), rstate: ti.types.ndarray(),
-                    rref: ti.types.ndarray(), simp: ti.types.ndarray()):
-    """Rigid blocks: force and moment of their nodes' forces about the centre, plus
-    gravity; local and global damping as for particles; leapfrog for the centre and
-    the angle; the nodes are then placed rigidly, x = c + R(θ)·r₀, and given the
-    rigid-body velocity v + ω × (x − c)."""
-    dt = simp[P_DT]
-    g = ti.Vector([simp[P_GX], simp[P_GY]])
-    alpha = simp[P_ALPHA]
-    alpha_l = simp[P_ALPHA_LOCAL]
-    ti.loop_config(serialize=True)
-    for r in range(rbody.shape[0]):
-        o = ti.cast(rbody[r, 0], ti.i32)
-        k = ti.cast(rbody[r, 1], ti.i32)
-        m = rbody[r, 2]
-        inertia = rbody[r, 3]
-        if k > 0:
-            c = ti.Vector([rstate[r, 0], rstate[r, 1]])
-            v0 = ti.Vector([rstate[r, 2], rstate[r, 3]])
-            w0 = rstate[r, 5]
-            f = m * g
-            mom = 0.0
-            for q in range(o, o + k):
-                fq = nforce[q]
-                d = npos[q] - c
-                f += fq
-                mom += d[0] * fq[1] - d[1] * fq[0]
-            v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
-            w1, md = damped_leapfrog(w0, mom, inertia, alpha, alpha_l, dt)
-            c1 = c + v1 * dt
-            th = rstate[r, 4] + w1 * dt
-            cs = ti.cos(th)
-            sn = ti.sin(th)
-            for q in range(o, o + k):
-                r0 = rref[q]
-                d = ti.Vector([cs * r0[0] - sn * r0[1], sn * r0[0] + cs * r0[1]])
-                npos[q] = c1 + d
-                nvel[q] = v1 + w1 * ti.Vector([-d[1], d[0]])
-            rstate[r, 0] = c1[0]
-            rstate[r, 1] = c1[1]
-            rstate[r, 2] = v1[0]
-            rstate[r, 3] = v1[1]
-            rstate[r, 4] = th
-            rstate[r, 5] = w1
 
 
 def _arr(spec, shape, dtype=ti.f64):
@@ -683,7 +569,7 @@ class Continuum:
         return self.nv and getattr(self, "_fix_fn", False)
 
     def integrate(self, sim):
-        """Stage: block nodes and rigid blocks move (tdem.integrate)."""
+        """Stage: block nodes and rigid blocks move (tdem.nodes)."""
         if self.nv:
             a = self.a
             if self.nrigid:

@@ -1,4 +1,4 @@
-"""PCMM element system (physics/pcmm.py): creation rules, superposition, masses.
+"""PCMM element system (physics/pcmm/): creation rules, superposition, masses.
 
 The paper's precision-test packings (Feng, Li & Oñate 2015, §3; 20 × 20 m):
 

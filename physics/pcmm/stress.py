@@ -1,0 +1,354 @@
+"""The stress pass of the PCMM elements (step 2) and the records the gather reads.
+
+:func:`stresses`: per computed element, N_e (recounted only where it can have
+changed), the stress update (Eqs. 6–12) and the record from which the gather
+(:func:`physics.pcmm.gather`) makes the nodal forces (Eqs. 13–14). The records'
+layout: :func:`_record`, :func:`_pack2`, :func:`_corner_force`.
+:func:`equation_of_state`: the per-particle state of JWL products and of a Fluid
+with an equation of state, and the stresses of their elements. The viscous and
+bulk-viscosity terms (:func:`viscous_stress`, :func:`bulk_viscosity`) act on the
+forces of the step only (the blocks share :func:`viscous_stress`).
+"""
+import taichi as ti
+
+from tdem.launch import cached
+
+from .. import fvm
+from ..materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
+from .layout import P_NEW, P_RECOUNT, P_SOFT
+from .rebuild import SLACK_FLOOR
+from .rules import _cover_incident, _sorted3
+
+
+LOW32 = 0xFFFFFFFF          # the low 32 bits of an i64
+
+
+@ti.func
+def _pack2(x, y, mark):
+    """x and y rounded to f32, side by side in the bits of one f64 slot; mark ≠ 0
+    sets the top bit, the sign of y, which must then be ≥ 0 (integer operations:
+    fast math need not keep the sign of a zero)."""
+    lo = ti.cast(ti.bit_cast(ti.cast(x, ti.f32), ti.i32), ti.i64) & ti.i64(LOW32)
+    hi = ti.cast(ti.bit_cast(ti.cast(y, ti.f32), ti.i32), ti.i64) << 32
+    if mark != 0:
+        hi = hi | (ti.cast(1, ti.i64) << 63)
+    return ti.bit_cast(lo | hi, ti.f64)
+
+
+@ti.func
+def _unpack2(v):
+    """x and y (as f64) of :func:`_pack2`, and whether the top bit is set."""
+    bits = ti.bit_cast(v, ti.i64)
+    lo = ti.bit_cast(ti.cast(bits & ti.i64(LOW32), ti.i32), ti.f32)
+    hi = ti.bit_cast(ti.cast(bits >> 32, ti.i32), ti.f32)
+    return ti.cast(lo, ti.f64), ti.cast(hi, ti.f64), bits < 0
+
+
+@ti.func
+def _record(efor: ti.template(), j, sig, sf, wf, de, eps, flag, mult, b, c):
+    """What the gather reads of the computed element (a, b, c): one 64-byte line per
+    element (``efor[j]``, j = ``eidx[a, s]``, see :func:`record_slots`; the records
+    lie side by side), weighted by the multiplicity w: the stress (0–3); the weight
+    1/N_e of the nodal forces (4; 0 for an element whose forces another pass
+    writes); rounded to f32 and packed two to a slot (:func:`_pack2`), the strain
+    increment (5: xx, yy; 6: xy) and the plastic shear strain increment (6, ≥ 0,
+    marked for a failed element); in the bits of slot 7, the corners b (bits 0–30)
+    and c (32–62), and in bit 31 whether the stress of the nodal forces ``sf`` is
+    not the stress (viscous stress, bulk viscosity), which then fills a second line
+    in the upper half of the array (``efor[C + j]``, C = half its size; xx, yy, xy).
+    The gather makes each corner's force from these and the positions of the other
+    two corners (:func:`_corner_force`), without looking the element up."""
+    w = ti.cast(mult, ti.f64)
+    ws = w * sig
+    d01 = _pack2(w * de[0], w * de[1], 0)
+    d2e = _pack2(w * de[2], ti.abs(w * eps), flag)
+    bits = ti.cast(b, ti.i64) | (ti.cast(c, ti.i64) << 32)
+    if sf[0] != sig[0] or sf[1] != sig[1] or sf[2] != sig[2]:
+        bits = bits | (ti.cast(1, ti.i64) << 31)
+        efor[efor.shape[0] // 2 + j] = ti.Vector([w * sf[0], w * sf[1], w * sf[2], 0.0, 0.0,
+                                                  0.0, 0.0, 0.0])
+    efor[j] = ti.Vector([ws[0], ws[1], ws[2], ws[3], wf, d01, d2e, ti.bit_cast(bits, ti.f64)])
+
+
+@ti.func
+def _corner_force(k, o, j, r, pos: ti.template(), efor: ti.template()):
+    """The force of the element (o, b, c) (counter-clockwise, created by o) on its
+    corner k from its record line r = ``efor[j]`` (:func:`_record`, which holds b and
+    c): :func:`physics.fvm.corner_force` with the stress of the forces (times the
+    multiplicity), the weight 1/N_e and the positions of the other two corners."""
+    bits = ti.bit_cast(r[7], ti.i64)
+    b = ti.cast(bits & ti.i64(0x7FFFFFFF), ti.i32)
+    c = ti.cast(bits >> 32, ti.i32)
+    u, v = b, c
+    if k == 1:
+        u, v = c, o
+    elif k == 2:
+        u, v = o, b
+    sf = ti.Vector([r[0], r[1], r[2], 0.0])
+    if (bits >> 31) & 1 != 0:
+        r2 = efor[efor.shape[0] // 2 + j]
+        sf = ti.Vector([r2[0], r2[1], r2[2], 0.0])
+    return fvm.corner_force(sf, pos[u], pos[v], r[4])
+
+
+@ti.func
+def _carried(a, b, c, s, jold, elem: ti.template(), ecnt: ti.template(), esig: ti.template(),
+             sigp: ti.template(), elem_old: ti.template(), esig_old: ti.template(),
+             ecnt_old: ti.template(), esrc: ti.template(), prb: ti.template()):
+    """Last step's stress of the element (a, b, c) in a's slot s, if it existed: a's
+    own slot when a kept its elements (at last step's record index ``jold`` of the
+    slot, or in ``esig`` where that is −1, see :func:`copies`), else the old slot
+    ``esrc`` points at, else the copy of b or c (their old lists when they rebuilt;
+    otherwise ``esig``, brought up to date there because they are dirty, and not
+    written by the stress pass). Returns (stress, found)."""
+    out = ti.Vector([0.0, 0.0, 0.0, 0.0])
+    found = False
+    if prb[a] == 0:
+        if jold >= 0:
+            out = sigp[jold]
+        else:
+            out = esig[a, s]
+        found = True
+    elif esrc[a, s] >= 0:
+        out = esig_old[a, esrc[a, s]]
+        found = True
+    else:
+        for t in ti.static(range(1, 3)):
+            o, u, w = b, c, a
+            if ti.static(t == 2):
+                o, u, w = c, a, b
+            if not found:
+                if prb[o] != 0:
+                    for so in range(ecnt_old[o]):
+                        if elem_old[o, so, 0] == u and elem_old[o, so, 1] == w:
+                            out = esig_old[o, so]
+                            found = True
+                else:
+                    for so in range(ecnt[o]):
+                        if elem[o, so, 0] == u and elem[o, so, 1] == w:
+                            out = esig[o, so]
+                            found = True
+    return out, found
+
+
+@cached
+@ti.kernel
+def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.ndarray(),
+             matp: ti.types.ndarray(), elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+             emult: ti.types.ndarray(), inc: ti.types.ndarray(), icnt: ti.types.ndarray(),
+             ncov: ti.types.ndarray(), ebud: ti.types.ndarray(), esig: ti.types.ndarray(),
+             sigp: ti.types.ndarray(), sigc: ti.types.ndarray(),
+             efor: ti.types.ndarray(), ede: ti.types.ndarray(), psig: ti.types.ndarray(),
+             pfail: ti.types.ndarray(), rad: ti.types.ndarray(),
+             elem_old: ti.types.ndarray(), esig_old: ti.types.ndarray(),
+             ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(), prb: ti.types.ndarray(),
+             pdirty: ti.types.ndarray(), unb: ti.types.ndarray(), pu: ti.types.ndarray(),
+             pflags: ti.types.ndarray(), ebase: ti.types.ndarray(), eidx: ti.types.ndarray(),
+             dt: ti.f64, carry: ti.template(), eos: ti.template(), serial: ti.template()):
+    """2. Per computed element: N_e (probe rule; recounted where the elements around
+    it changed or its vertices' neighbourhoods moved farther than the count's slack,
+    ``ebud``, the same bookkeeping as :func:`rebuild_elements`), σ_old (the element's
+    own stress of last step if it existed and ``carry``, else the mean of its
+    particles' stresses), Eqs. 6–11 with the Jaumann rotation (velocity gradient on
+    the mid-step configuration, see :mod:`physics.blocks`), the constitutive
+    correction (Eq. 12), and the record from which the gather makes the nodal
+    forces with the weight 1/N_e (Eqs. 13–14, sign fixed; :func:`_record`), in the
+    next place of the particle's run of records (``eidx``, :func:`record_slots`);
+    the stress at the same place of ``sigc`` (:func:`copies`)."""
+    new = pflags[P_NEW] != 0
+    soft = pflags[P_SOFT] != 0
+    ti.loop_config(serialize=serial)
+    for a in range(pmat.shape[0]):
+        j = ebase[a]
+        for s in range(ecnt[a]):
+            if emult[a, s] > 0:
+                jold = eidx[a, s]
+                eidx[a, s] = j
+                b = elem[a, s, 0]
+                c = elem[a, s, 1]
+                v0, v1, v2 = _sorted3(a, b, c)
+                # uw, or where it already says the count stands (the usual case) an
+                # upper bound of it: v1 and v2 are Eq. 1 neighbours of v0, so their
+                # u relative to v0 are at most unb[v0] (bitwise: the same roots)
+                eb = ebud[a, s]
+                need = new or pdirty[v0] + pdirty[v1] + pdirty[v2] > 0
+                uw = unb[v0] + ti.max(unb[v1], unb[v2])
+                if need or soft or uw >= eb:
+                    u0 = pu[v0]
+                    uw = ti.max(unb[v0], ti.max(unb[v1] + (pu[v1] - u0).norm(),
+                                                unb[v2] + (pu[v2] - u0).norm()))
+                cover = ncov[a, s]
+                if need or uw >= eb:
+                    cv, sl = _cover_incident(v0, v1, v2, pos, elem, inc, icnt, emult)
+                    cover = cv
+                    ncov[a, s] = cv
+                    if not new:
+                        ti.atomic_add(pflags[P_RECOUNT], 1)
+                    ebud[a, s] = sl - (0.0 if soft else uw) - SLACK_FLOOR * rad[a]
+                elif soft:
+                    ebud[a, s] -= uw
+                grad, de, area = _kinematics(a, b, c, pos, vel, dt)
+                M = pmat[a]
+                kind = ti.cast(matp[M, 0], ti.i32)
+                sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                eps = 0.0
+                flag = 0
+                if kind != JWL_TYPE:
+                    # (a JWL element takes the mean of its particles' pressures: the
+                    # particles carry the equation of state, see the gather below)
+                    found = False
+                    if ti.static(carry):
+                        sig, found = _carried(a, b, c, s, jold, elem, ecnt, esig, sigp,
+                                              elem_old, esig_old, ecnt_old, esrc, prb)
+                    if not found:
+                        sig = (psig[a] + psig[b] + psig[c]) / 3.0
+                    sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+                        de, matp[M, 2], matp[M, 3])
+                    failed = 0
+                    if pfail[a] + pfail[b] + pfail[c] > 0:
+                        failed = 1
+                    sig, eps, flag = mc_correct_state(sig, matp, M, failed)
+                sigc[j] = sig
+                _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp, emult,
+                        efor, ede, dt, eos)
+                j += 1
+
+
+@ti.func
+def _kinematics(a, b, c, pos: ti.template(), vel: ti.template(), dt):
+    """Velocity gradient (Eq. 6), strain increment (Eq. 7) and area of the element
+    (a, b, c) on the mid-step configuration x − ½Δt·v: Δθ·area is then exactly the
+    area change of the step (the area is quadratic in the positions)."""
+    va, vb, vc = vel[a], vel[b], vel[c]
+    h = 0.5 * dt
+    ya, yb, yc = pos[a] - h * va, pos[b] - h * vb, pos[c] - h * vc
+    grad = fvm.velocity_gradient(ya, yb, yc, va, vb, vc)
+    return grad, fvm.strain_increment(grad, dt), fvm.area(ya, yb, yc)
+
+
+@ti.func
+def _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp: ti.template(),
+            emult: ti.template(), efor: ti.template(), ede: ti.template(), dt,
+            eos: ti.template()):
+    """The end of step 2 for element (a, s) with its corrected stress: the state
+    the equation of state reads (``ede``), the stress of its nodal forces
+    (artificial bulk viscosity and viscous stress included) and the gather's record
+    (``efor``), from which the gather makes the forces."""
+    q = bulk_viscosity(matp, M, de, dt, area)
+    if ti.static(eos):
+        ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64),
+                               area / cover, q * (de[0] + de[1])])
+    sf = sig
+    wf = 0.0
+    if not _has_eos(matp, M):
+        sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
+        wf = 1.0 / cover
+    _record(efor, j, sig, sf, wf, de, eps, flag, emult[a, s], b, c)
+
+
+@cached
+@ti.kernel
+def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
+                      rad: ti.types.ndarray(), pos: ti.types.ndarray(),
+                      elem: ti.types.ndarray(), ecnt: ti.types.ndarray(),
+                      emult: ti.types.ndarray(), inc: ti.types.ndarray(),
+                      icnt: ti.types.ndarray(), ncov: ti.types.ndarray(),
+                      sigc: ti.types.ndarray(), efor: ti.types.ndarray(),
+                      eidx: ti.types.ndarray(),
+                      ede: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
+                      time: ti.f64, serial: ti.template()):
+    """2j. Particles with an equation of state (JWL, or a Fluid with
+    ``equation_of_state``): the state at x_n. A particle's volume changes by a third
+    of Σ_e (S_e/N_e) Δθ_e over its elements (so that Σ_i p_i ΔVol_i is the elements'
+    pressure work exactly). JWL: its energy changes by −(p + q) ΔVol with the p its
+    elements pushed with over that change (last step's, so that the energy lost is
+    exactly the work the forces did), p = F·p_JWL(V, E) with F the programmed burn
+    fraction. Fluid: p(V) of :class:`physics.materials.Fluid` (a state function:
+    deleting or creating elements does not change it).
+    2k. Their elements: the mean pressure of their particles, the viscous stress
+    2μ·dev(D) (Fluid) and the artificial bulk viscosity q (forces only)."""
+    n = pmat.shape[0]
+    ti.loop_config(serialize=serial)
+    for i in range(n):
+        M = pmat[i]
+        if M >= 0:
+            if _has_eos(matp, M):
+                thsum = 0.0
+                qsum = 0.0
+                for k in range(icnt[i]):
+                    code = inc[i, k]
+                    o = code >> 6
+                    sl = (code >> 2) & 15
+                    d = ede[o, sl]
+                    mw = ti.cast(emult[o, sl], ti.f64)
+                    thsum += mw * d[5] * (d[0] + d[1])
+                    qsum += mw * d[5] * d[6]
+                js = pjwl[i]
+                V0 = js[4]
+                V = js[0] + thsum / (3.0 * V0)
+                if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                    F = 0.0
+                    if time >= js[2]:
+                        F = ti.min(1.0, (time - js[2]) * matp[M, 10] / (3.0 * rad[i]))
+                    E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
+                    p = F * jwl_pressure(matp, M, V, E)
+                    pjwl[i] = ti.Vector([V, E, js[2], p, V0])
+                else:
+                    pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), V0])
+    ti.loop_config(serialize=serial)
+    for a in range(n):
+        for s in range(ecnt[a]):
+            if emult[a, s] > 0:
+                M = pmat[a]
+                if _has_eos(matp, M):
+                    b = elem[a, s, 0]
+                    c = elem[a, s, 1]
+                    pm = (pjwl[a][3] + pjwl[b][3] + pjwl[c][3]) / 3.0
+                    sig = ti.Vector([-pm, -pm, 0.0, -pm])
+                    sigc[eidx[a, s]] = sig
+                    d = ede[a, s]
+                    de = ti.Vector([d[0], d[1], d[2]])
+                    q = 0.0
+                    if d[0] + d[1] < 0.0:
+                        q = d[6] / (d[0] + d[1])
+                    sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
+                    _record(efor, eidx[a, s], sig, sf, 1.0 / ncov[a, s], de, d[3],
+                            ti.cast(d[4], ti.i32), emult[a, s], b, c)
+
+
+@ti.func
+def bulk_viscosity(matp: ti.template(), M, de, dt, area):
+    """Pressure q ≥ 0 of the artificial bulk viscosity of columns 12–13 (module
+    docstring of :mod:`physics.materials`), for a shrinking element only."""
+    q = 0.0
+    th = de[0] + de[1]
+    b1 = matp[M, 12]
+    b2 = matp[M, 13]
+    if th < 0.0 and b1 + b2 > 0.0:
+        L = ti.sqrt(ti.abs(area))
+        rate = -th / dt
+        rho = matp[M, 1]
+        c = ti.sqrt((matp[M, 2] + 4.0 * matp[M, 3] / 3.0) / rho)
+        q = rho * L * rate * (b1 * c + b2 * L * rate)
+    return q
+
+
+@ti.func
+def _has_eos(matp: ti.template(), M):
+    """Whether material row M keeps its pressure per particle: JWL, or a Fluid with
+    ``equation_of_state`` (column 4 = 1)."""
+    kind = ti.cast(matp[M, 0], ti.i32)
+    return kind == JWL_TYPE or (kind == FLUID and matp[M, 4] > 0.0)
+
+
+@ti.func
+def viscous_stress(matp: ti.template(), M, de, dt):
+    """Viscous stress 2μ·dev(D) of a Fluid row (μ in column 11), D = Δε/Δt in plane
+    strain (D_zz = 0); zero for other materials. Not accumulated: it acts on the
+    forces of the step only."""
+    mu = matp[M, 11]
+    out = ti.Vector([0.0, 0.0, 0.0, 0.0])
+    if mu > 0.0:
+        tr = (de[0] + de[1]) / 3.0
+        out = 2.0 * mu / dt * ti.Vector([de[0] - tr, de[1] - tr, de[2], -tr])
+    return out
