@@ -1,0 +1,274 @@
+"""The handles a model hands back: particle groups, walls, blocks and result views.
+
+:class:`ParticleGroup` (what ``add_particles`` returns), :class:`Wall` (``add_wall``:
+velocity, servo control, the force it receives), :class:`Block` (``add_block``:
+nodes, fixes, elements), and the small helpers that check the inputs they share.
+Each handle reads and writes the state of the :class:`tdem.Simulation` it belongs to.
+"""
+import math
+
+import numpy as np
+
+
+from . import mesh as _mesh
+from . import step as stepk
+from .errors import InputError
+
+
+def _vector2(name, value):
+    """One 2-vector (gravity, a velocity, a point)."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be two numbers, got {value!r}") from None
+    if a.shape != (2,) or not np.isfinite(a).all():
+        raise InputError(f"{name} must be two finite numbers (x, y), got {value!r}")
+    return a
+
+
+def _as_xy(name, value, n=None):
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers, got {value!r}") from None
+    if n is not None and a.shape == (2,):
+        a = np.broadcast_to(a, (n, 2)).copy()
+    if a.ndim != 2 or a.shape[1] != 2 or (n is not None and a.shape[0] != n):
+        want = f"({n}, 2)" if n is not None else "(N, 2)"
+        raise InputError(f"{name} must have shape {want} or (2,), got shape {a.shape}")
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(f"{name} must be finite: row {k} is {a[k].tolist()}")
+    return a
+
+
+class ParticleGroup:
+    """Particles added by one call of :meth:`Simulation.add_particles`."""
+
+    def __init__(self, sim, ids, contact, density):
+        self._sim = sim
+        self.ids = ids
+        self.contact = contact
+        self.density = density
+
+    def __len__(self):
+        return len(self.ids)
+
+    def __repr__(self):
+        return f"ParticleGroup({len(self.ids)} particles, ids {self.ids[0]}..{self.ids[-1]})"
+
+
+class Block:
+    """A deformable block: a triangle mesh with fixed connectivity (spec §4), made by
+    :meth:`Simulation.add_block`. Its nodes carry lumped masses ρ·S/3; its
+    triangles the stress (same FVM update as the PCMM elements, weight 1)."""
+
+    def __init__(self, sim, index, vertices, triangles, material, slot, velocity):
+        self._sim = sim
+        self.index = index
+        self.vertices = vertices
+        self.triangles = triangles
+        self.material = material
+        self.slot = slot
+        self.velocity = velocity
+        self._fixes = []
+        self._offset = 0
+        self.rigid = False
+
+    def __len__(self):
+        return len(self.vertices)
+
+    def __repr__(self):
+        return (f"Block({len(self.vertices)} nodes, {len(self.triangles)} triangles, "
+                f"{self.material!r})")
+
+    def fix(self, nodes, vx=0.0, vy=None):
+        """Prescribe velocity components of ``nodes`` (indices into the block's
+        vertices): each of vx, vy is None (free), a float, an array (one per node)
+        or a function of time returning either."""
+        ids = np.atleast_1d(np.asarray(nodes, dtype=np.int64))
+        nv = len(self.vertices)
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= nv:
+            raise InputError(f"nodes must be vertex indices of the block in [0, {nv}), got "
+                             f"{ids.tolist()[:8]}")
+        vals = [_fix_value(name, v, ids) for name, v in (("vx", vx), ("vy", vy))]
+        self._fixes.append((ids, *vals))
+        cont = self._sim._cont
+        if cont is not None:
+            cont.apply_node_fixes(self._sim.time, initial=True)
+
+    def kinematic(self):
+        """Whether every node has both velocity components prescribed (the block then
+        moves as told: a driven rigid tool, for instance)."""
+        fx = np.zeros(len(self.vertices), bool)
+        fy = np.zeros(len(self.vertices), bool)
+        for ids, vx, vy in self._fixes:
+            fx[ids] |= vx is not None
+            fy[ids] |= vy is not None
+        return bool(fx.all() and fy.all())
+
+    def nodes(self):
+        """Node state now, a dict of numpy arrays: position, velocity, force (of the
+        elements and contacts), reaction (of the prescribed velocities), mass,
+        displacement."""
+        if self._sim._cont is None:
+            x = self.vertices
+            z = np.zeros_like(x)
+            return {"position": x.copy(), "velocity": np.broadcast_to(self.velocity, x.shape).copy(),
+                    "force": z.copy(), "reaction": z.copy(),
+                    "mass": _mesh.nodal_masses(x, self.triangles, self.material.density),
+                    "displacement": z.copy()}
+        return self._sim._cont.block_nodes(self)
+
+    def elements(self):
+        """Triangles now: triangles (T, 3), stress (T, 2, 2), stress_zz, plastic_strain,
+        failed."""
+        self._sim._require_built()
+        return self._sim._cont.block_elements(self)
+
+    def nodes_in(self, xmin=-np.inf, xmax=np.inf, ymin=-np.inf, ymax=np.inf):
+        """Indices of the vertices (initial positions) inside the box."""
+        return _in_box(self.vertices, xmin, xmax, ymin, ymax)
+
+
+def _in_box(x, xmin, xmax, ymin, ymax):
+    return np.flatnonzero((x[:, 0] >= xmin) & (x[:, 0] <= xmax) &
+                          (x[:, 1] >= ymin) & (x[:, 1] <= ymax))
+
+
+def _fix_value(name, v, ids):
+    if v is None or callable(v):
+        return v
+    a = np.broadcast_to(np.asarray(v, dtype=float), ids.shape).copy() \
+        if np.ndim(v) <= 1 and (np.ndim(v) == 0 or len(v) == len(ids)) else None
+    if a is None or not np.isfinite(a).all():
+        raise InputError(f"{name} must be None, a finite number, {len(ids)} numbers "
+                         f"or a function of time, got {v!r}")
+    return a
+
+
+class Wall:
+    """A rigid segment. ``velocity`` and ``angular_velocity`` may be changed between runs."""
+
+    def __init__(self, sim, index):
+        self._sim = sim
+        self.index = index
+
+    def _row(self):
+        return self._sim._wall_rows()[self.index]
+
+    def _set(self, cols, values):
+        rows = self._sim._wall_rows()
+        rows[self.index, cols] = values
+        self._sim._set_wall_rows(rows)
+
+    @property
+    def velocity(self):
+        r = self._row()
+        return np.array([r[stepk.W_VX], r[stepk.W_VY]])
+
+    @velocity.setter
+    def velocity(self, v):
+        v = _vector2("velocity", v)
+        self._set([stepk.W_VX, stepk.W_VY], v)
+
+    @property
+    def angular_velocity(self):
+        """Angular velocity about :attr:`center`, rad/s, counter-clockwise positive."""
+        return float(self._row()[stepk.W_OMEGA])
+
+    @angular_velocity.setter
+    def angular_velocity(self, w):
+        w = float(w)
+        if not math.isfinite(w):
+            raise InputError(f"angular_velocity must be finite, got {w!r}")
+        self._set([stepk.W_OMEGA], [w])
+
+    @property
+    def center(self):
+        r = self._row()
+        return np.array([r[stepk.W_CX], r[stepk.W_CY]])
+
+    @property
+    def endpoints(self):
+        r = self._row()
+        return np.array([[r[stepk.W_X0], r[stepk.W_Y0]], [r[stepk.W_X1], r[stepk.W_Y1]]])
+
+    def servo(self, force=None, stress=None, direction=None, relaxation=0.5, max_speed=None):
+        """Drive this wall so that it receives ``force`` (N per metre of thickness,
+        compression-positive) — or ``stress`` × its length — along ``direction`` (the unit
+        direction in which it moves to compress; default: its normal pointing to the
+        particles that touch it, else to the left of p0→p1). The speed is set every step
+        on the device from the force received, with a gain from the contact stiffness
+        (relaxation in (0, 1]); ``max_speed`` caps it (default: 0.01 × the smallest radius
+        per step). ``wall.servo()`` switches the control off and stops the wall."""
+        sim = self._sim
+        row = self._row()
+        if force is None and stress is None:
+            self._set([stepk.W_SERVO_K, stepk.W_VX, stepk.W_VY], [0.0, 0.0, 0.0])
+            return self
+        if (force is None) == (stress is None):
+            raise InputError(f"give force or stress, not both: force={force!r}, stress={stress!r}")
+        a, b = self.endpoints
+        length = float(np.linalg.norm(b - a))
+        target = float(force) if force is not None else float(stress) * length
+        if not math.isfinite(target):
+            raise InputError(f"force must be finite, got {target!r}")
+        if direction is None:
+            t = (b - a) / length
+            d = np.array([-t[1], t[0]])
+            x = sim.particles.numpy(stress=False)["position"] if sim.n_particles else None
+            if x is not None and len(x):
+                mid = 0.5 * (a + b)
+                if np.dot(x.mean(axis=0) - mid, d) < 0:
+                    d = -d
+        else:
+            d = _vector2("direction", direction)
+            if np.linalg.norm(d) == 0:
+                raise InputError(f"direction must not be zero, got {direction!r}")
+            d = d / np.linalg.norm(d)
+        relaxation = float(relaxation)
+        if not 0.0 < relaxation <= 1.0:
+            raise InputError(f"relaxation must lie in (0, 1], got {relaxation!r}")
+        law = sim._laws[int(row[stepk.W_LAW])]
+        r = sim._radii()
+        rmean = float(r.mean()) if len(r) else 1.0
+        k = law.critical_stiffness(rmean, 1.0)
+        dt = sim.dt
+        if max_speed is None:
+            max_speed = 0.01 * float(r.min() if len(r) else 1.0) / dt
+        max_speed = float(max_speed)
+        if not (max_speed > 0 and math.isfinite(max_speed)):
+            raise InputError(f"max_speed must be a positive number, got {max_speed!r}")
+        self._set([stepk.W_SERVO_K, stepk.W_SERVO_F, stepk.W_SERVO_DX, stepk.W_SERVO_DY,
+                   stepk.W_SERVO_ALPHA, stepk.W_SERVO_VMAX, stepk.W_OMEGA],
+                  [k, target, d[0], d[1], relaxation, max_speed, 0.0])
+        return self
+
+    @property
+    def force(self):
+        """Total contact force (2,) this wall received in the last step."""
+        return self._sim._wall_loads()[self.index, :2].copy()
+
+    @property
+    def moment(self):
+        """Moment of the contact forces about the wall's centre in the last step."""
+        return float(self._sim._wall_loads()[self.index, 2])
+
+    def __repr__(self):
+        return f"Wall({self.index}, endpoints={self.endpoints.tolist()})"
+
+
+class _View:
+    """``sim.particles`` / ``sim.contacts``: ``.numpy()`` gives a dict of arrays."""
+
+    def __init__(self, fn, count):
+        self._fn = fn
+        self._count = count
+
+    def numpy(self, **options):
+        return self._fn(**options)
+
+    def __len__(self):
+        return self._count()

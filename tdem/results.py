@@ -1,0 +1,176 @@
+"""Reading results back: particles, contacts, elements, energy.
+
+:class:`Results` is the part of :class:`tdem.Simulation` that copies device state to
+numpy for the user (``sim.particles.numpy()``, ``sim.contacts.numpy()``,
+``sim.elements.numpy()``, ``sim.point_edge_contacts()``, ``sim.energy()``); it runs
+between run segments, never inside the time loop.
+"""
+
+import numpy as np
+import taichi as ti
+
+from physics import contact_law as _claw
+
+from . import state as schema
+from . import step as stepk
+
+
+
+class Results:
+    """What :class:`tdem.Simulation` reads back to numpy (module docstring)."""
+
+
+    # ------------------------------------------------------------------ reading
+    def _particles_numpy(self, stress=True):
+        """Particle state; ``stress=False`` skips the stress (computed from the contacts)."""
+        if not self._built:
+            self._build()
+        if self._n == 0:
+            z2 = np.zeros((0, 2))
+            z = np.zeros(0)
+            out = {"position": z2, "velocity": z2, "omega": z, "radius": z, "mass": z,
+                   "force": z2, "torque": z, "displacement": z2}
+            if stress:
+                out.update(stress=np.zeros((0, 2, 2)), stress_zz=z, pressure=z,
+                           plastic_strain=z, strain=np.zeros((0, 3)))
+            return out
+        a = self._a
+        prop = a["prop"].to_numpy()
+        pos = a["pos"].to_numpy()
+        out = {
+            "position": pos, "velocity": a["vel"].to_numpy(), "omega": a["omega"].to_numpy(),
+            "radius": prop[:, 0].copy(), "mass": prop[:, 1].copy(),
+            "force": a["force"].to_numpy(), "torque": a["torque"].to_numpy(),
+            "displacement": pos - a["pos0"].to_numpy(),
+        }
+        if stress:
+            sa = self._a.get("stress_out")
+            if sa is None or sa.shape[0] != self._n:
+                sa = self._a["stress_out"] = ti.ndarray(ti.f64, (self._n, 3))
+            stepk.particle_stress(*schema.bind(stepk.particle_stress, a, out=sa))
+            s = sa.to_numpy()
+            st = np.zeros((self._n, 2, 2))
+            st[:, 0, 0], st[:, 1, 1] = s[:, 0], s[:, 1]
+            st[:, 0, 1] = st[:, 1, 0] = s[:, 2]
+            szz = np.zeros(self._n)
+            out["plastic_strain"] = np.zeros(self._n)
+            out["strain"] = np.zeros((self._n, 3))
+            if self._cont is not None and self._cont.has_pcmm:
+                c = self._cont.particle_fields()
+                sel = c["pmat"] >= 0
+                s4 = c["stress4"]
+                st[sel, 0, 0], st[sel, 1, 1] = s4[sel, 0], s4[sel, 1]
+                st[sel, 0, 1] = st[sel, 1, 0] = s4[sel, 2]
+                szz[sel] = s4[sel, 3]
+                out["plastic_strain"] = c["plastic_strain"]
+                out["strain"] = c["strain"]
+                out["failed"] = c["failed"]
+                out["elements"] = c["elements"]
+            out["stress"] = st
+            out["stress_zz"] = szz
+            out["pressure"] = -(st[:, 0, 0] + st[:, 1, 1] + szz) / 3.0
+            # a disc's own stress has no out-of-plane part: its pressure is the in-plane mean
+            if self._cont is None or not self._cont.has_pcmm:
+                out["pressure"] = -(st[:, 0, 0] + st[:, 1, 1]) / 2.0
+            else:
+                dem = ~sel
+                out["pressure"][dem] = -(st[dem, 0, 0] + st[dem, 1, 1]) / 2.0
+        return out
+
+    def _contacts_numpy(self):
+        """Contacts in force now: pairs (C,2) (j = -1 - wall index for walls), normal (C,)
+        compression-positive, shear (C,), moment (C,) (rolling couple on the first),
+        direction (C,2) the unit normal, overlap (C,), point (C,2)."""
+        if not self._built:
+            self._build()
+        if self._n == 0:
+            return {"pairs": np.zeros((0, 2), np.int64), "normal": np.zeros(0),
+                    "shear": np.zeros(0), "moment": np.zeros(0),
+                    "direction": np.zeros((0, 2)), "overlap": np.zeros(0),
+                    "point": np.zeros((0, 2))}
+        a = self._a
+        cs = a["cs"].to_numpy()
+        nbr = a["nbr"].to_numpy()
+        hist = a["hist"].to_numpy()
+        cn = a["cn"].to_numpy()
+        pos = a["pos"].to_numpy()
+        r = a["prop"].to_numpy()[:, 0]
+        ii, kk = np.nonzero((cs[:, :, 2] > 0) & (np.arange(self._cap)[None, :] <
+                                                  a["ncnt"].to_numpy()[:, None]))
+        jj = nbr[ii, kk]
+        u = cs[ii, kk, 2]
+        normal_dir = cn[ii, kk]
+        pts = pos[ii] + (r[ii] - 0.5 * u)[:, None] * normal_dir
+        wcs = a["wcs"].to_numpy()
+        wid = a["wid"].to_numpy()
+        wi, wk = np.nonzero((wid >= 0) & (wcs[:, :, 2] > 0))
+        wu = wcs[wi, wk, 2]
+        wn = a["wcn"].to_numpy()[wi, wk]
+        whist = a["whist"].to_numpy()
+        R = _claw.history_width(self._law_set)     # the rolling couple's column
+        return {
+            "pairs": np.concatenate([np.stack([ii, jj], 1),
+                                     np.stack([wi, -1 - wid[wi, wk]], 1)]).astype(np.int64),
+            "normal": np.concatenate([cs[ii, kk, 0], wcs[wi, wk, 0]]),
+            "shear": np.concatenate([cs[ii, kk, 1], wcs[wi, wk, 1]]),
+            "moment": np.concatenate([hist[ii, kk, R], whist[wi, wk, R]]),
+            "direction": np.concatenate([normal_dir, wn]),
+            "overlap": np.concatenate([u, wu]),
+            "point": np.concatenate([pts, pos[wi] + (r[wi] - 0.5 * wu)[:, None] * wn]),
+        }
+
+    def _elements_numpy(self):
+        """PCMM elements now (copies included): triangles (E, 3) of particle indices,
+        owner, area, n_cover (N_e), weight (1/N_e), stress (E, 2, 2), stress_zz."""
+        if not self._built:
+            self._build()
+        if self._cont is None or not self._cont.has_pcmm:
+            return {"triangles": np.zeros((0, 3), np.int64), "owner": np.zeros(0, np.int64),
+                    "area": np.zeros(0), "n_cover": np.zeros(0, np.int64),
+                    "weight": np.zeros(0), "stress": np.zeros((0, 2, 2)),
+                    "stress_zz": np.zeros(0)}
+        return self._cont.elements()
+
+    def point_edge_contacts(self):
+        """Point–edge contacts in force now (particle–block and block–block), a dict of
+        numpy arrays: point (C, 2) (particle centre or block vertex), foot (C, 2)
+        (its projection on the edge), normal (C,) compression-positive, shear (C,),
+        broken (C,) (cohesion and tension lost), kind (C,) 0 particle, 1 vertex."""
+        self._require_built()
+        pos = self._a["pos"].to_numpy() if self._n else np.zeros((0, 2))
+        if self._cont is None:
+            return {
+                "point": np.zeros((0, 2)), "foot": np.zeros((0, 2)), "normal": np.zeros(0),
+                "shear": np.zeros(0), "broken": np.zeros(0, bool), "kind": np.zeros(0, int)}
+        return self._cont.point_edge_contacts(pos)
+
+    def energy(self):
+        """Energy account (J per metre of thickness) at the last completed step:
+        kinetic, gravitational (relative to the origin), elastic (springs),
+        dissipated (damping, friction, rolling), boundary_work (done by walls and
+        prescribed velocities) and total = kinetic + gravitational + elastic +
+        dissipated − boundary_work, which is conserved for DEM models; explosive: the
+        internal energy Σ E·V0 of JWL particles (not in total: the strain energy of
+        the continuum elements is not counted)."""
+        if not self._built:
+            self._build()
+        a = self._a
+        eacc = a["eacc"].to_numpy()
+        estate = a["estate"].to_numpy()
+        el = stepk.elastic_energy_sum(*schema.bind(stepk.elastic_energy_sum, a,
+                                                   laws=self._law_set))
+        e = {"kinetic": float(estate[:, 0].sum()), "gravitational": float(estate[:, 1].sum()),
+             "elastic": float(el), "dissipated": float(eacc[:, 0].sum()),
+             "boundary_work": float(eacc[:, 1].sum())}
+        e["total"] = e["kinetic"] + e["gravitational"] + e["elastic"] + e["dissipated"] \
+            - e["boundary_work"]
+        e["explosive"] = self._explosive_energy()
+        return e
+
+    def _explosive_energy(self):
+        """Σ E_i·V0_i of the JWL particles (V0 = m/ρ0): their internal energy."""
+        c = self._cont
+        if c is None or not getattr(c, "has_pcmm", False) or len(c.jwl_ids) == 0:
+            return 0.0
+        st = c.jwl_state()[c.jwl_ids]
+        return float(np.sum(st[:, 1] * st[:, 4]))

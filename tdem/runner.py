@@ -1,0 +1,557 @@
+"""The runner: device state, run segments, snapshots, growth and replay.
+
+:class:`Runner` is the part of :class:`tdem.Simulation` that turns the model the
+user built into device arrays and advances it:
+
+- building and rebuilding the device state (:mod:`tdem.state` declares the arrays),
+  uploading laws, parameters, walls and prescribed velocities, fitting the cell grid;
+- :meth:`Runner.run`: run segments of ``check_interval`` steps; the host looks at the
+  device only between segments (status word, monitors, output);
+- :meth:`Runner._one_step`: one time step, the stages in the order the data flows —
+  the one place where a reader sees the data flow of a step;
+- a snapshot of the dynamic state at the start of each segment: a slot overflow
+  restores it, grows the arrays and redoes the steps; an instability restores it,
+  replays step by step to name the step and the particle, and raises
+  :class:`tdem.InstabilityError`.
+
+It uses the model attributes that :class:`tdem.Simulation` sets up (``_host``,
+``_laws``, ``_walls_host``, ``_cont``, ``_fixes`` …) and owns the device ones (``_a``,
+``_slots``, ``_snap`` …).
+"""
+import math
+import sys
+import time as _time
+
+import numpy as np
+import taichi as ti
+
+from physics import contact_law as _claw
+
+from . import backend, neighbors
+from . import state as schema
+from . import step as stepk
+from .continuum import Continuum
+from .errors import CapacityError, InputError, InstabilityError
+from .neighbors import F_BAD, F_NEED, F_REBUILD, F_WALL_NEED, FLAGS_SIZE
+
+
+MAX_SLOTS = 1024
+
+
+class Runner:
+    """Device state and the run loop of :class:`tdem.Simulation` (module docstring)."""
+
+
+    def _law_table(self):
+        nl = max(len(self._laws), 1)
+        t = np.zeros((nl, nl), dtype=np.int32)
+        for a in range(nl):
+            for b in range(nl):
+                t[a, b] = self._pair_override.get((a, b), max(a, b))
+        return t
+
+    # ------------------------------------------------------------ device state
+    def _sizes(self, n, cap, capw, nwalls, nlaws, ncell):
+        """The sizes :func:`tdem.state.allocate` takes, for this model."""
+        return {"n": n, "cap": cap, "capw": capw, "walls": max(nwalls, 1), "laws": nlaws,
+                "law_width": _claw.table_width(self._law_set), "cells": ncell,
+                "cell_starts": ncell + 4096, "flags": FLAGS_SIZE, "simp": stepk.SIMP_SIZE,
+                "wall_width": stepk.WALL_WIDTH, "laws_set": self._law_set}
+
+    def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
+        return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
+
+    def _fresh_state(self):
+        self._law_set = _claw.registered()
+        pos = np.concatenate(self._host["pos"])
+        vel = np.concatenate(self._host["vel"])
+        r = np.concatenate(self._host["radius"])
+        rho = np.concatenate(self._host["density"])
+        m = rho * np.pi * r ** 2
+        if self._cont is not None and self._cont.has_pcmm:
+            pm = self._cont.masses
+            m = np.where(np.isnan(pm), m, pm)
+        n = len(r)
+        s = self._new_rows(pos, vel, r, m, np.concatenate(self._host["law"]), self._cap,
+                           self._capw)
+        s["flags"] = np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32)
+        return s
+
+    def _new_rows(self, pos, vel, r, m, law, cap, capw):
+        """State rows of new particles (every saved per-particle and per-slot array)."""
+        sizes = self._sizes(len(r), cap, capw, 1, 1, 1)
+        return schema.fresh_rows(len(r), sizes, {
+            "pos": pos, "vel": vel, "pos0": pos, "xref": pos,
+            "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
+            "plaw": np.broadcast_to(np.asarray(law, np.int32), (len(r),))})
+
+    def _build(self):
+        if self._n == 0 and not self._blocks:
+            raise InputError("the simulation has no particles: call add_particles first")
+        if self._slots:
+            self._cont = self._new_continuum()
+            for kind, ids, coef, block in self._nonreflect:
+                self._cont.set_non_reflecting(
+                    kind, ids + block._offset if kind == "v" else ids, coef)
+            for ids, times in self._lights:
+                self._cont.light(ids, times)
+        if self._n == 0:
+            # blocks only: no particle arrays, the engine's parameters only
+            self._a = {"simp": ti.ndarray(ti.f64, (stepk.SIMP_SIZE,))}
+            self._built = True
+            self._upload_params()
+            return
+        self._rebuild_from(self._fresh_state())
+
+    def _new_continuum(self):
+        """The continuum (PCMM elements, blocks, couples) of the particles as added."""
+        if self._n:
+            pos = np.concatenate(self._host["pos"])
+            rad = np.concatenate(self._host["radius"])
+            pmat = np.concatenate(self._host["mat"]).astype(np.int64)
+        else:
+            pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
+        return Continuum(pos, rad, pmat, self._slots, self._blocks, couples=self._couple_rows())
+
+    def _require_built(self):
+        if not self._built:
+            self._build()
+
+    def _rebuild_from(self, state, new_particles=None):
+        """(Re)allocate every array for the current sizes and fill it from ``state``."""
+        self._set_law_set(state)
+        if new_particles is not None:
+            pos, vel, r, rho, law = new_particles
+            m = rho * np.pi * r ** 2
+            n = len(r)
+            add = self._new_rows(pos, vel, r, m, law, state["nbr"].shape[1],
+                                 state["wid"].shape[1])
+            for k, v in add.items():
+                state[k] = np.concatenate([state[k], v])
+            state["flags"][F_REBUILD] = 1
+        n = self._n
+        nwalls = len(self._walls_host)
+        ncell = self._grid_cells_for(state["pos"], state["prop"][:, 0])
+        self._a = self._allocate(n, self._cap, self._capw, nwalls, max(len(self._laws), 1), ncell)
+        self._snap = {}
+        for k, v in state.items():
+            if k in self._a:
+                self._fill(k, v)
+        self._built = True
+        self._a["facc"].from_numpy(np.zeros((n, 3)))  # sums start from zero every step
+        self._upload_laws()
+        self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.WALL_WIDTH), fresh=True)
+        self._fit_grid(force=True)
+        self._apply_fixes(initial=True)
+        self._upload_params()
+        self._a["flags"][F_REBUILD] = 1
+
+    def _fill(self, k, v):
+        arr = self._a[k]
+        v = np.asarray(v)
+        want = tuple(arr.shape) + ((arr.n,) if hasattr(arr, "n") else ())
+        if v.shape != want:
+            # pad or cut the slot dimension (growth of capacities)
+            out = np.full(want, -1 if v.dtype.kind == "i" else 0, dtype=v.dtype)
+            sl = tuple(slice(0, min(a, b)) for a, b in zip(want, v.shape))
+            out[sl] = v[sl]
+            v = out
+        arr.from_numpy(v.astype(np.int32 if v.dtype.kind in "iu" else
+                                (np.float64 if arr.dtype == ti.f64 else np.float32)))
+
+    def _download(self):
+        """Every device array as numpy; the host copy of the walls follows the device."""
+        out = {k: self._a[k].to_numpy() for k in schema.saved()}
+        self._walls_host = list(out["wall"][:len(self._walls_host)])
+        return out
+
+    def _set_law_set(self, state):
+        """Take the contact laws registered now (the kernels' ``laws``); the history
+        arrays of ``state`` get the columns these laws need."""
+        self._law_set = _claw.registered()
+        for k, width in (("hist", _claw.pair_history_width(self._law_set)),
+                         ("whist", _claw.wall_history_width(self._law_set))):
+            if k in state:
+                state[k] = _claw.remap_history(state[k], width, tail=4 if k == "hist" else 3)
+
+    def _upload_laws(self):
+        width = _claw.table_width(self._law_set)
+        rows = np.array([law.row(width) for law in self._laws], dtype=float)
+        self._a["lawp"].from_numpy(rows)
+        self._a["lawpair"].from_numpy(self._law_table())
+
+    def _upload_params(self):
+        p = np.zeros(stepk.SIMP_SIZE)
+        p[stepk.P_DT] = self.dt
+        p[stepk.P_GX], p[stepk.P_GY] = self.gravity
+        p[stepk.P_ALPHA] = self.global_damping
+        p[stepk.P_ALPHA_LOCAL] = self.local_damping
+        p[stepk.P_SKIN] = self.skin
+        p[stepk.P_NWALLS] = len(self._walls_host)
+        self._a["simp"].from_numpy(p)
+        self._dt_run = p[stepk.P_DT]
+
+    def _wall_rows(self):
+        if not self._built:
+            return np.array(self._walls_host, dtype=float).reshape(-1, stepk.WALL_WIDTH)
+        return self._a["wall"].to_numpy()[:len(self._walls_host)]
+
+    def _set_wall_rows(self, rows, fresh=False):
+        if not self._built:
+            self._walls_host = list(rows)
+            return
+        full = np.zeros((max(len(rows), 1), stepk.WALL_WIDTH))
+        full[:len(rows)] = rows
+        self._a["wall"].from_numpy(full)
+        self._walls_host = list(rows)
+        self._a["flags"][F_REBUILD] = 1
+
+    def _wall_loads(self):
+        if not self._built:
+            return np.zeros((len(self._walls_host), 4))
+        return self._a["wforce"].to_numpy()[:len(self._walls_host)]
+
+    def _grid_cells_for(self, pos, radius):
+        h = 2.0 * float(radius.max()) + self.skin
+        span = np.ptp(pos, axis=0) + 4 * h
+        nx, ny = (np.ceil(span / h).astype(int) + 1)
+        return int(max(nx * ny, 1))
+
+    def _fit_grid(self, force=False):
+        """Fit the cell grid to the particles' bounding box (host side, at checks)."""
+        a = self._a
+        neighbors.bounds(a["pos"], a["prop"], a["bounds"])
+        b = a["bounds"].to_numpy()
+        lo, hi, rmax = b[:2], b[2:4], b[4]
+        if not np.all(np.isfinite(b)) or hi[0] < lo[0]:
+            return
+        h = 2.0 * rmax + self.skin
+        gp = a["gridp"].to_numpy()
+        gn = a["gridn"].to_numpy()
+        self._last_fit = self._steps
+        if not force:
+            cur_lo = gp[:2]
+            cur_hi = cur_lo + gp[2] * gn[:2]
+            inside = np.all(lo >= cur_lo) and np.all(hi <= cur_hi)
+            if inside and gp[2] >= h and np.prod((hi - lo) / gp[2] + 1) > 0.25 * gn[0] * gn[1]:
+                return
+        margin = 2 * h
+        lo = lo - margin
+        span = (hi + margin) - lo
+        ncap = a["cell_count"].shape[0]
+        limit = max(4 * self._n + 1024, ncap)
+        nx, ny = (np.floor(span / h).astype(np.int64) + 1)
+        while nx * ny > limit:
+            h *= 1.5
+            nx, ny = (np.floor(span / h).astype(np.int64) + 1)
+        if nx * ny > ncap or ny > 4096:
+            self._a["cell_count"] = ti.ndarray(ti.i32, (int(nx * ny),))
+            self._a["cell_start"] = ti.ndarray(ti.i32, (int(nx * ny) + max(int(ny), 4096),))
+        a["gridp"].from_numpy(np.array([lo[0], lo[1], h, 0.0]))
+        a["gridn"].from_numpy(np.array([nx, ny, 0, 0], dtype=np.int32))
+        a["flags"][F_REBUILD] = 1
+        self._last_fit = self._steps
+
+    def _apply_fixes(self, initial=False, t=None):
+        """Upload prescribed velocities: all of them (``initial``), else only the values
+        of the functions of time, evaluated at ``t``. The host keeps its own copy, so a
+        step reads nothing back from the device."""
+        if not self._fixes:
+            return
+        t = self._time if t is None else t
+        if initial:
+            fix = np.zeros(self._n, np.int32)
+            self._vfix_host = np.zeros((self._n, 3))
+        vfix = self._vfix_host
+        any_fn = False
+        for ids, *vals in self._fixes:
+            for bit, col, v in zip((1, 2, 4), range(3), vals):
+                if v is None:
+                    continue
+                if initial:
+                    fix[ids] |= bit
+                if callable(v):
+                    any_fn = True
+                    vfix[ids, col] = np.broadcast_to(np.asarray(v(t), dtype=float), ids.shape)
+                elif initial:
+                    vfix[ids, col] = v
+        if initial:
+            self._a["fix"].from_numpy(fix)
+            self._fix_fn = any_fn
+        self._a["vfix"].from_numpy(vfix.astype(np.float64 if self._fdt == ti.f64 else np.float32))
+
+    # ------------------------------------------------------------------ stepping
+    def _step_args(self):
+        # the arrays by name; _one_step appends the last three (detail, continuum, laws)
+        return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
+                           detail=False, continuum=False, laws=self._law_set)[:-3]
+
+    def _xforce(self):
+        if self._cont is not None:
+            return self._cont.a["xforce"]
+        x = self._a.get("xforce_none")
+        if x is None:
+            x = self._a["xforce_none"] = schema.ndarray(2, ti.f64, (1,))
+        return x
+
+
+
+    def _serial(self):
+        """Whether this model's kernels run their loops on one thread
+        (:func:`tdem.backend.serial_loops`, by the number of particles and block nodes)."""
+        cont = self._cont
+        nodes = cont.nv if cont is not None else 0
+        elements = cont is not None and (cont.has_pcmm or nodes > 0)
+        return backend.serial_loops(self._n + nodes, elements)
+
+    def _engine_args(self):
+        """Arguments of the step and rebuild kernels; the PCMM candidate search reach."""
+        if self._cont is not None and self._cont.has_pcmm:
+            h = float(self._a["gridp"].to_numpy()[2])
+            self._reach = max(1, int(math.ceil((self._cont.reach_length + 2 * self.skin) / h)))
+        else:
+            self._reach = 1
+        if self._n == 0:
+            return None, None
+        return self._step_args(), self._rebuild_args()
+
+    def _rebuild_args(self):
+        return schema.bind(neighbors.rebuild, self._a, sorted_ids=self._a["sorted"],
+                           nwalls=len(self._walls_host), skin=float(self.skin))
+
+    def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
+        """One time step: the stages in the order the data flows (Feng et al.'s seven
+        steps). Each stage owns what it writes:
+
+        1. prescribed velocities (functions of time) uploaded — ``vfix``, node fixes;
+        2. neighbour lists rebuilt when the skin check asked — slots and histories;
+        3. PCMM elements (physics.pcmm) — element stresses, ``xforce``;
+        4. blocks (physics.blocks) — triangle stresses, ``nforce``;
+        5. point–edge contacts (coupling) — ``xforce``, ``nforce``;
+        6. viscous (non-reflecting) boundaries — ``xforce``, ``nforce``;
+        7. DEM pairs and walls, gathered with ``xforce``, and the particles' damped
+           leapfrog (tdem.step, one kernel) — particle state, contacts, walls;
+        8. block nodes and rigid blocks integrated (tdem.integrate) — node state.
+        """
+        cont = self._cont
+        dt = self._dt_run
+        if self._n and self._fix_fn:
+            self._apply_fixes(t=self._time)
+        if cont is not None:
+            cont.prescribed(self)
+        # on a GPU the rebuild kernel runs every step and returns at once unless the
+        # device raised the flag; on the CPU the host reads the flag (shared memory)
+        if self._n and (not host_reads_flag or self._a["flags"][F_REBUILD] != 0):
+            neighbors.rebuild(*rebuild_args)
+        if cont is not None:
+            cont.pcmm_elements(self, dt, self._reach)
+            cont.block_stresses(self, dt)
+            cont.point_edge(self, dt)
+            cont.viscous_boundaries(self)
+        if self._n:
+            stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set)
+        if cont is not None:
+            cont.integrate(self)
+        self._time += dt
+        self._steps += 1
+
+    def _take_snapshot(self):
+        if self._cont is not None:
+            self._cont.take_snapshot()
+        self._snap_clock = (self._time, self._steps)
+        if self._n == 0:
+            return
+        names = schema.dynamic()
+        for k in names:
+            src = self._a[k]
+            dst = self._snap.get(k)
+            if dst is None or tuple(dst.shape) != tuple(src.shape):
+                self._snap[k] = schema.like(src)
+        schema.copy(self._a, self._snap, names, self._serial())
+        self._snap_clock = (self._time, self._steps)
+
+    def _restore_snapshot(self):
+        if self._cont is not None:
+            self._cont.restore_snapshot()
+        if self._n:
+            schema.copy(self._snap, self._a, schema.dynamic(), self._serial())
+        self._time, self._steps = self._snap_clock
+        for m in self._monitors:
+            m.truncate(self._steps)
+        if self._output is not None:
+            self._output.truncate(self._steps)
+
+    def _status(self):
+        a = self._a
+        if self._n == 0:
+            return np.array([0, 0, 0, 0, 0, 0, 0, 0], np.int32)
+        stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["flags"],
+                              float(self._dt_run))
+        return a["flags"].to_numpy()
+
+    def _grow(self, flags):
+        need, needw = int(flags[F_NEED]), int(flags[F_WALL_NEED])
+        state = self._download()
+        if need > self._cap:
+            new = 1 << int(math.ceil(math.log2(need + 1)))  # a power of two
+            if new > MAX_SLOTS:
+                raise CapacityError(f"a particle has {need} neighbours within its cut-off; more "
+                                    f"than {MAX_SLOTS} slots are not supported (check radii and "
+                                    "the skin)")
+            self._cap = new
+        if needw > self._capw:
+            self._capw = needw + 1
+        state["flags"][F_NEED] = 0
+        state["flags"][F_WALL_NEED] = 0
+        state["flags"][F_REBUILD] = 1
+        self._rebuild_from(state)
+
+    def run(self, until=None, steps=None):
+        """Advance to simulated time ``until`` or by ``steps`` steps."""
+        if (until is None) == (steps is None):
+            raise InputError(f"give exactly one of until= or steps=, got until={until!r}, "
+                             f"steps={steps!r}")
+        if not self._built:
+            self._build()
+        if self._n:
+            self._upload_laws()      # a law's parameters may have changed since (law.update)
+        if self._cont is not None:
+            self._cont.upload_materials()
+        self._crit_cache = None
+        if self._dt_user is not None:
+            self._check_dt_value(self._dt_user)  # particles or laws may have changed since
+        self._upload_params()
+        dt = self._dt_run
+        if steps is not None:
+            if int(steps) != steps or steps < 0:
+                raise InputError(f"steps must be a whole number >= 0, got {steps!r}")
+            target = self._steps + int(steps)
+        else:
+            until = float(until)
+            if not math.isfinite(until):
+                raise InputError(f"until must be a finite time, got {until!r}")
+            target = self._steps + max(0, int(math.ceil((until - self._time) / dt - 1e-9)))
+        total = target - self._steps
+        self._plan_events()
+        bar = self._progress_bar(total)
+        t_wall = _time.perf_counter()
+        done_at_start = self._steps
+        try:
+            while self._steps < target:
+                self._segment(target, bar)
+                if bar is not None:
+                    bar.update(self._steps - bar.n - done_at_start)
+                    el = _time.perf_counter() - t_wall
+                    bar.set_postfix_str(f"t={self._time:.4g}s, "
+                                        f"{self._dofs() * (self._steps - done_at_start) / max(el, 1e-9):.3g} "
+                                        "particle-steps/s")
+        except KeyboardInterrupt:
+            self._restore_snapshot()
+            self._on_abort("interrupted")
+            raise
+        except InstabilityError:
+            self._on_abort("unstable")
+            raise
+        finally:
+            if bar is not None:
+                bar.close()
+        if self._output is not None:
+            self._output.flush(self)
+        return self
+
+    def _segment(self, target, bar):
+        """Up to ``check_interval`` steps from a snapshot, then one look at the device."""
+        n = min(self.check_interval, target - self._steps)
+        self._take_snapshot()
+        sargs, rargs = self._engine_args()
+        host_flag = self._host_reads_flag
+        for s in range(n):
+            # output-only quantities are stored on the steps something will read them
+            detail = s == n - 1 or self._steps + 1 >= self._next_event
+            self._one_step(sargs, rargs, host_flag, detail)
+            if self._steps >= self._next_event:
+                self._events()
+        flags = self._status()
+        if self._cont is not None:
+            need, bad = self._cont.status()
+            if need > self._cont.capacity:
+                self._restore_snapshot()
+                self._cont.grow(need)
+                return
+            if bad >= 0:
+                self._find_instability()
+        if self._n and (flags[F_NEED] > self._cap or flags[F_WALL_NEED] > self._capw):
+            self._restore_snapshot()
+            self._grow(flags)
+            return
+        if flags[F_BAD] < self._n:
+            self._find_instability()
+        if self._n and self._steps - self._last_fit >= self.check_interval:
+            self._fit_grid()
+
+    def _find_instability(self):
+        """Replay the last segment one step at a time to name the failing step."""
+        self._restore_snapshot()
+        sargs, rargs = self._engine_args()
+        host_flag = self._host_reads_flag
+        for _ in range(self.check_interval + 1):
+            self._take_snapshot()
+            self._one_step(sargs, rargs, host_flag, True)
+            flags = self._status()
+            if self._cont is not None and self._cont.status()[1] >= 0:
+                v = self._cont.status()[1]
+                step, t = self._steps, self._time
+                nodes = self._cont.a["npos"].to_numpy()[v], self._cont.a["nvel"].to_numpy()[v]
+                self._restore_snapshot()
+                b = next(b for b in self._blocks if b._offset <= v < b._offset + len(b))
+                raise InstabilityError(
+                    f"unstable at step {step} (t = {t:.6g} s): node {v - b._offset} of block "
+                    f"{b.index} has position {nodes[0].tolist()} and velocity "
+                    f"{nodes[1].tolist()} (dt = {self._dt_run:.3g} s). The last good state "
+                    f"(step {self._steps}) is kept; reduce dt_fraction.",
+                    step=step, time=t, particle=-1)
+            if flags[F_BAD] < self._n:
+                k = int(flags[F_BAD])
+                step, t = self._steps, self._time
+                s = self._particles_numpy(stress=False)
+                self._restore_snapshot()
+                raise InstabilityError(
+                    f"unstable at step {step} (t = {t:.6g} s): particle {k} has position "
+                    f"{s['position'][k].tolist()} and velocity {s['velocity'][k].tolist()} "
+                    f"(dt = {self._dt_run:.3g} s). The last good state (step {self._steps}) is "
+                    "kept; reduce dt_fraction or check stiffnesses.",
+                    step=step, time=t, particle=k)
+        self._restore_snapshot()
+        raise InstabilityError("unstable run (could not isolate the step)")
+
+    def _events(self):
+        """Record the monitors and write the output that are due now."""
+        for m in self._monitors:
+            if self._steps >= m.next_step:
+                m.record(self)
+        if self._output is not None and self._steps >= self._output.next_step(self):
+            self._output.write(self)
+        self._plan_events()
+
+    def _plan_events(self):
+        nxt = [m.next_step for m in self._monitors]
+        if self._output is not None:
+            nxt.append(self._output.next_step(self))
+        self._next_event = min(nxt) if nxt else 1 << 62
+
+    def _on_abort(self, why):
+        if self._output is not None:
+            self._output.abort(self, why)
+
+    def _dofs(self):
+        """Particles plus block nodes (the bodies the throughput counts)."""
+        return self._n + (self._cont.nv if self._cont is not None else 0)
+
+    def _progress_bar(self, total):
+        show = self.progress
+        if show is None:
+            show = sys.stderr.isatty() and self._dofs() * total > 2e7
+        if not show or total <= 0:
+            return None
+        from tqdm.auto import tqdm
+        return tqdm(total=total, unit="step", desc="tdem", leave=False)
