@@ -53,6 +53,8 @@ def indices(name, value, n, what="particle"):
     except (TypeError, ValueError):
         raise InputError(f"{name} must be {what} indices or a boolean mask, got "
                          f"{value!r}") from None
+    if a.size == 0:
+        raise InputError(f"{name} selects no {what}")
     if a.dtype == bool:
         if a.ndim != 1 or len(a) != n:
             raise InputError(f"{name}: a boolean mask must have one entry per {what} "
@@ -62,10 +64,9 @@ def indices(name, value, n, what="particle"):
         raise InputError(f"{name} must be integer {what} indices or a boolean mask, got "
                          f"{a.dtype} values {a.ravel().tolist()[:8]}")
     a = a.astype(np.int64).ravel()
-    if a.size == 0:
-        raise InputError(f"{name} selects no {what}")
     bad = a[(a < 0) | (a >= n)]
     if bad.size:
-        raise InputError(f"{name} must hold {what} indices in [0, {n}), got "
+        many = {"vertex": "vertices"}.get(what, what + "s")
+        raise InputError(f"{name} must be {many} of this model (indices in [0, {n})), got "
                          f"{bad.tolist()[:8]}")
     return a

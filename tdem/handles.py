@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from physics.validate import indices
 
 from . import mesh as _mesh
 from . import step as stepk
@@ -87,11 +88,7 @@ class Block:
         """Prescribe velocity components of ``nodes`` (indices into the block's
         vertices): each of vx, vy is None (free), a float, an array (one per node)
         or a function of time returning either."""
-        ids = np.atleast_1d(np.asarray(nodes, dtype=np.int64))
-        nv = len(self.vertices)
-        if ids.size == 0 or ids.min() < 0 or ids.max() >= nv:
-            raise InputError(f"nodes must be vertex indices of the block in [0, {nv}), got "
-                             f"{ids.tolist()[:8]}")
+        ids = indices("nodes", nodes, len(self.vertices), "vertex")
         vals = [_fix_value(name, v, ids) for name, v in (("vx", vx), ("vy", vy))]
         self._fixes.append((ids, *vals))
         cont = self._sim._cont
@@ -140,8 +137,11 @@ def _in_box(x, xmin, xmax, ymin, ymax):
 def _fix_value(name, v, ids):
     if v is None or callable(v):
         return v
-    a = np.broadcast_to(np.asarray(v, dtype=float), ids.shape).copy() \
-        if np.ndim(v) <= 1 and (np.ndim(v) == 0 or len(v) == len(ids)) else None
+    try:
+        a = np.broadcast_to(np.asarray(v, dtype=float), ids.shape).copy() \
+            if np.ndim(v) <= 1 and (np.ndim(v) == 0 or len(v) == len(ids)) else None
+    except (TypeError, ValueError):
+        a = None
     if a is None or not np.isfinite(a).all():
         raise InputError(f"{name} must be None, a finite number, {len(ids)} numbers "
                          f"or a function of time, got {v!r}")

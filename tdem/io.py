@@ -32,7 +32,7 @@ class Monitor:
     def __init__(self, name, fn, every=100, start=0):
         if not callable(fn):
             raise InputError(f"fn must be a function of the simulation, got {fn!r}")
-        if int(every) != every or every < 1:
+        if not isinstance(every, (int, float, np.integer)) or int(every) != every or every < 1:
             raise InputError(f"every must be a whole number of steps >= 1, got {every!r}")
         self.name = str(name)
         self.fn = fn
@@ -41,7 +41,12 @@ class Monitor:
         self.steps, self.times, self.values = [], [], []
 
     def record(self, sim):
-        value = np.asarray(self.fn(sim), dtype=float)   # first: fn may raise
+        got = self.fn(sim)          # first: fn may raise
+        try:
+            value = np.asarray(got, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"monitor {self.name!r}: its function must return a number or "
+                             f"an array of numbers, got {got!r}") from None
         self.steps.append(sim.steps)
         self.times.append(sim.time)
         self.values.append(value)

@@ -211,14 +211,26 @@ class Runner:
             return np.zeros((len(self._walls_host), 4))
         return self._a["wforce"].to_numpy()[:len(self._walls_host)]
 
+    def _cell_limit(self):
+        """Most cells the grid may have: memory stays O(particles) wherever they are."""
+        return 4 * self._n + 1024
+
     def _grid_cells_for(self, pos, radius):
         h = 2.0 * float(radius.max()) + self.skin
         span = np.ptp(pos, axis=0) + 4 * h
-        nx, ny = (np.ceil(span / h).astype(int) + 1)
-        return int(max(nx * ny, 1))
+        nx, ny = (np.ceil(span / h).astype(np.int64) + 1)
+        return int(max(min(nx * ny, self._cell_limit()), 1))
 
     def _fit_grid(self, force=False):
-        """Fit the cell grid to the particles' bounding box (host side, at checks)."""
+        """Fit the cell grid to the particles (host side, at checks).
+
+        The grid covers the particles' bounding box with cells of the largest
+        diameter plus the skin, in at most :meth:`_cell_limit` cells. Where a few
+        particles lie far from the rest (the box would need more cells), it covers
+        the bulk — the box of the 0.5 %–99.5 % quantiles of the positions — and the
+        cells along its edges take the particles outside (cell indices are clamped:
+        particles that touch still fall in neighbouring cells, so no contact is
+        missed). Only where even the bulk is too wide do the cells grow."""
         a = self._a
         neighbors.bounds(a["pos"], a["prop"], a["bounds"])
         b = a["bounds"].to_numpy()
@@ -229,21 +241,39 @@ class Runner:
         gp = a["gridp"].to_numpy()
         gn = a["gridn"].to_numpy()
         self._last_fit = self._steps
+        bulk = getattr(self, "_grid_bulk", None)
         if not force:
             cur_lo = gp[:2]
             cur_hi = cur_lo + gp[2] * gn[:2]
-            inside = np.all(lo >= cur_lo) and np.all(hi <= cur_hi)
-            if inside and gp[2] >= h and np.prod((hi - lo) / gp[2] + 1) > 0.25 * gn[0] * gn[1]:
-                return
+            if bulk is not None:
+                # fitted to the bulk: refit once the whole box has changed by a cell
+                if gp[2] >= h and np.all(np.abs(b[:4] - bulk) <= h):
+                    return
+            else:
+                inside = np.all(lo >= cur_lo) and np.all(hi <= cur_hi)
+                if (inside and gp[2] >= h
+                        and np.prod((hi - lo) / gp[2] + 1) > 0.25 * gn[0] * gn[1]):
+                    return
         margin = 2 * h
-        lo = lo - margin
-        span = (hi + margin) - lo
-        ncap = a["cell_count"].shape[0]
-        limit = max(4 * self._n + 1024, ncap)
-        nx, ny = (np.floor(span / h).astype(np.int64) + 1)
+        limit = self._cell_limit()
+
+        def cells(lo, hi, h):
+            return np.floor((hi - lo + 2 * margin) / h).astype(np.int64) + 1
+
+        self._grid_bulk = None
+        nx, ny = cells(lo, hi, h)
+        if nx * ny > limit and self._n >= 2:
+            pos = a["pos"].to_numpy()
+            qlo, qhi = np.quantile(pos, [0.005, 0.995], axis=0, method="nearest")
+            if np.prod(cells(qlo, qhi, h)) <= limit:
+                self._grid_bulk = b[:4].copy()
+                lo, hi = qlo, qhi
+                nx, ny = cells(lo, hi, h)
         while nx * ny > limit:
             h *= 1.5
-            nx, ny = (np.floor(span / h).astype(np.int64) + 1)
+            nx, ny = cells(lo, hi, h)
+        lo = lo - margin
+        ncap = a["cell_count"].shape[0]
         if nx * ny > ncap or ny > 4096:
             self._a["cell_count"] = ti.ndarray(ti.i32, (int(nx * ny),))
             self._a["cell_start"] = ti.ndarray(ti.i32, (int(nx * ny) + max(int(ny), 4096),))

@@ -23,19 +23,47 @@ from physics import contact_law as _claw
 from physics.contact_law import ContactLaw
 from physics.linear import LinearContact
 from physics.materials import Material, MohrCoulomb
+from physics.validate import in_range, indices, non_negative
 
 from . import backend
 from . import mesh as _mesh
 from . import step as stepk
 from .errors import InputError
-from .neighbors import F_BUILDS
 from .handles import (Block, ParticleGroup, Wall, _View, _as_xy, _fix_value, _in_box,
                       _vector2)
 from .results import Results
+from .neighbors import F_BUILDS
 from .runner import MAX_SLOTS, Runner  # noqa: F401  (MAX_SLOTS: part of this module's names)
 
 # the engine's arrays are declared in tdem.state; the run loop is tdem.runner's, the
 # numpy views tdem.results'
+
+
+def _per_particle(name, value, n):
+    """A number or one number per particle, as n floats; refused naming ``name``."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number or one per particle ({n}), got "
+                         f"{value!r}") from None
+    if a.ndim > 1 or (a.ndim == 1 and len(a) != n):
+        raise InputError(f"{name} must be a number or one per particle ({n}), got "
+                         f"shape {a.shape}")
+    return np.broadcast_to(a, (n,)).copy()
+
+
+def _refuse_coincident(old, new):
+    """Refuse new particles whose centre coincides with another's (a contact of no
+    direction: the run would fail at its first step)."""
+    allpos = np.concatenate([old, new])
+    _, inverse, counts = np.unique(allpos, axis=0, return_inverse=True, return_counts=True)
+    dup = np.flatnonzero(counts[inverse.ravel()] > 1)
+    if dup.size:
+        same = dup[np.all(allpos[dup] == allpos[dup[0]], axis=1)]
+        i, j = int(same[0]), int(same[1])
+        raise InputError(f"positions: particles {i} and {j} have the same centre "
+                         f"{tuple(float(c) for c in allpos[i])} (indices counted over the "
+                         f"whole model)")
 
 
 class Simulation(Runner, Results):
@@ -63,12 +91,9 @@ class Simulation(Runner, Results):
         g = _vector2("gravity", gravity)
         if precision not in ("f64", "f32"):
             raise InputError(f"precision must be 'f64' or 'f32', got {precision!r}")
-        dt_fraction = float(dt_fraction)
-        if not (0.0 < dt_fraction <= 1.0):
-            raise InputError(f"dt_fraction must lie in (0, 1], got {dt_fraction!r}")
+        dt_fraction = in_range("dt_fraction", dt_fraction, 0.0, 1.0, lo_open=True)
         for name, v in (("local_damping", local_damping), ("global_damping", global_damping)):
-            if not (float(v) >= 0.0 and math.isfinite(float(v))):
-                raise InputError(f"{name} must be a number >= 0, got {v!r}")
+            non_negative(name, v)
         if float(local_damping) >= 1.0:
             raise InputError(f"local_damping must lie in [0, 1), got {local_damping!r}")
         if skin is not None and not (float(skin) > 0.0 and math.isfinite(float(skin))):
@@ -169,7 +194,6 @@ class Simulation(Runner, Results):
                 fr = math.tan(math.radians(material.friction_angle)) \
                     if isinstance(material, MohrCoulomb) else 0.5
                 contact = LinearContact(kn=young, ks=young, friction=fr)
-            slot = self._slot_of(material, tol)
         elif self._built and self._cont is not None:
             raise InputError("positions: particles cannot be added after the first run of a "
                              "model with PCMM particles or blocks")
@@ -177,16 +201,12 @@ class Simulation(Runner, Results):
         n = len(pos)
         if n == 0:
             raise InputError("positions must hold at least one particle, got none")
-        try:
-            r = np.broadcast_to(np.asarray(radius, dtype=float), (n,)).copy()
-        except ValueError:
-            raise InputError(f"radius must be a number or one per particle ({n}), "
-                             f"got shape {np.shape(radius)}") from None
+        r = _per_particle("radius", radius, n)
         bad = ~(np.isfinite(r) & (r > 0))
         if bad.any():
             k = int(np.argmax(bad))
             raise InputError(f"radius must be positive: particle {k} has radius {float(r[k])!r}")
-        rho = np.broadcast_to(np.asarray(density, dtype=float), (n,)).copy()
+        rho = _per_particle("density", density, n)
         bad = ~(np.isfinite(rho) & (rho > 0))
         if bad.any():
             k = int(np.argmax(bad))
@@ -194,8 +214,15 @@ class Simulation(Runner, Results):
         if contact is None:
             raise InputError("contact must be given: a law such as tdem.LinearContact(kn=...)")
         vel = np.zeros((n, 2)) if velocity is None else _as_xy("velocity", velocity, n)
-        law = self._law_id(contact)
         state = self._download() if self._built else None
+        old = state["pos"] if state is not None else (
+            np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, 2)))
+        _refuse_coincident(old, pos)
+        # every check passed: from here on the model changes (the law is checked
+        # before it is added)
+        law = self._law_id(contact)
+        if material is not None:
+            slot = self._slot_of(material, tol)
         ids = np.arange(self._n, self._n + n)
         self._host["pos"].append(pos)
         self._host["vel"].append(vel)
@@ -265,15 +292,22 @@ class Simulation(Runner, Results):
                 raise InputError(f"a must be another block of this simulation, got {a!r}")
             if self._built:
                 raise InputError("a: couples must be set up before the first run")
+            for ids0, a0, b0, _ in self._couples:
+                if ids0 is None and {id(a0), id(b0)} == {id(a), id(b)}:
+                    raise InputError(f"a: the blocks {a!r} and {b!r} are coupled already "
+                                     f"(a second couple would double the contact stiffness)")
             self._couples.append((None, a, b, law))
             return
-        ids = a.ids if isinstance(a, ParticleGroup) else np.atleast_1d(np.asarray(a))
-        ids = np.asarray(ids, dtype=np.int64)
-        if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
-            raise InputError(f"a must be particles of this simulation (indices in "
-                             f"[0, {self._n})), got {ids.tolist()[:8]}")
+        ids = indices("a", a, self._n)
         if self._built:
             raise InputError("a: couples must be set up before the first run")
+        for ids0, a0, b0, _ in self._couples:
+            if ids0 is not None and b0 is b:
+                both = np.intersect1d(ids0, ids)
+                if both.size:
+                    raise InputError(f"a: particles {both.tolist()[:8]} are coupled to "
+                                     f"{b!r} already (a second couple would double the "
+                                     f"contact stiffness)")
         self._couples.append((ids, None, b, law))
 
     def non_reflecting(self, target, normal=None):
@@ -300,7 +334,8 @@ class Simulation(Runner, Results):
             be = _mesh.boundary_edges(block.triangles)
             x = block.vertices
             bnodes = np.unique(be)
-            nodes = bnodes if nodes is None else np.atleast_1d(np.asarray(nodes, np.int64))
+            nodes = bnodes if nodes is None else indices("target: nodes", nodes,
+                                                         len(block.vertices), "vertex")
             if nodes.size == 0 or not np.isin(nodes, bnodes).all():
                 raise InputError(f"target: nodes must be boundary nodes of the block, got "
                                  f"{np.asarray(nodes).tolist()[:8]}")
@@ -321,11 +356,7 @@ class Simulation(Runner, Results):
             area = trib[nodes]
             kind, ids = "v", nodes
         else:
-            ids = target.ids if isinstance(target, ParticleGroup) else target
-            ids = np.atleast_1d(np.asarray(ids, np.int64))
-            if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
-                raise InputError(f"target must be particle indices in [0, {self._n}), a block "
-                                 f"or (block, nodes), got {np.asarray(ids).tolist()[:8]}")
+            ids = indices("target", target, self._n)
             slots = np.concatenate(self._host["mat"])[ids]
             if (slots < 0).any() or len(np.unique(slots)) != 1:
                 raise InputError("target: a viscous boundary needs PCMM particles of one "
@@ -386,11 +417,7 @@ class Simulation(Runner, Results):
         :class:`ParticleGroup` of JWL particles. Unlit JWL particles have no pressure.
         """
         from physics.materials import JWL
-        ids = target.ids if isinstance(target, ParticleGroup) else target
-        ids = np.atleast_1d(np.asarray(ids, np.int64))
-        if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
-            raise InputError(f"target must be particle indices in [0, {self._n}) or a group, "
-                             f"got {np.asarray(ids).tolist()[:8]}")
+        ids = indices("target", target, self._n)
         slots = np.concatenate(self._host["mat"])[ids]
         mats = {self._slots[int(k)][0] if k >= 0 else None for k in np.unique(slots)}
         if len(mats) != 1 or not isinstance(next(iter(mats)), JWL):
@@ -497,10 +524,7 @@ class Simulation(Runner, Results):
         Each of vx, vy, omega is None (free), a float, an array (one per id) or a
         function of time returning either.
         """
-        ids = np.atleast_1d(np.asarray(ids, dtype=np.int64))
-        if ids.size == 0 or ids.min() < 0 or ids.max() >= self._n:
-            raise InputError(f"ids must be particle indices in [0, {self._n}), got "
-                             f"{ids.tolist()[:8]}")
+        ids = indices("ids", ids, self._n)
         vals = [_fix_value(name, v, ids) for name, v in (("vx", vx), ("vy", vy), ("omega", omega))]
         self._fixes.append((ids, *vals))
         if self._built:

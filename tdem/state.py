@@ -185,7 +185,7 @@ def fresh_rows(n, sizes, values):
 @cached
 @ti.kernel
 def _copy(src: ti.types.ndarray(), dst: ti.types.ndarray(), serial: ti.template()):
-    ti.loop_config(serialize=serial)
+    # (a loop over an external array's indices: Taichi has no one-thread form of it)
     for I in ti.grouped(src):
         dst[I] = src[I]
 
