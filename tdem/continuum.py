@@ -46,8 +46,11 @@ _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig",
                            "nflags", "psedge", "psforce", "psbroken", "vsedge", "vsforce",
                            "vsbroken", "rstate")
 # what a checkpoint saves: the dynamic state and the nodes' initial positions (the rest
-# is set up again from the host description)
-SAVED = _SNAP + ("npos0",)
+# is set up again from the host description), and what the element system derives at
+# each step that ``elements()`` reads (element areas and N_e: a loaded model reports
+# them before its first step; files without them still load)
+SAVED_DERIVED = ("earea", "ncov")
+SAVED = _SNAP + ("npos0",) + SAVED_DERIVED
 
 
 @cached
@@ -647,18 +650,15 @@ class Continuum:
         self._full = True
 
     # ------------------------------------------------------------------ reading
-    def elements(self):
-        """PCMM elements now (copies included): triangles (E, 3), owner, area, n_cover,
-        weight (1/N_e), stress (E, 2, 2), stress_zz (E,)."""
+    def _slots_of_elements(self):
+        """(owner, slot, inv, src) of every element slot: ``inv`` the triangle each
+        slot holds (copies of a triangle share it), ``src`` the slot whose element is
+        computed (the copy with ``emult`` > 0), per triangle."""
         a = self.a
-        self.sync_copies()
         ecnt = a["ecnt"].to_numpy()
         owner = np.repeat(np.arange(self.n), ecnt)
         slot = np.arange(len(owner)) - np.repeat(np.cumsum(ecnt) - ecnt, ecnt)
         elem = a["elem"].to_numpy()[owner, slot]
-        ncov = a["ncov"].to_numpy()[owner, slot]
-        sig = a["esig"].to_numpy()[owner, slot]
-        # copies of a triangle are computed once (the copy with emult > 0): fill the others
         mult = a["emult"].to_numpy()[owner, slot]
         key = np.sort(np.column_stack([owner, elem]), axis=1)
         _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
@@ -666,6 +666,26 @@ class Continuum:
         comp = np.flatnonzero(mult > 0)
         src = np.empty(len(first), np.int64)
         src[inv[comp]] = comp
+        return owner, slot, elem, inv, src
+
+    def synced_cover(self):
+        """N_e of every element slot, copies given their computed copy's (what a
+        checkpoint saves: a loaded model, whose copies are not mapped yet, reads it
+        from any copy)."""
+        owner, slot, _, inv, src = self._slots_of_elements()
+        ncov = self.a["ncov"].to_numpy()
+        ncov[owner, slot] = ncov[owner, slot][src[inv]]
+        return ncov
+
+    def elements(self):
+        """PCMM elements now (copies included): triangles (E, 3), owner, area, n_cover,
+        weight (1/N_e), stress (E, 2, 2), stress_zz (E,)."""
+        a = self.a
+        self.sync_copies()
+        owner, slot, elem, inv, src = self._slots_of_elements()
+        ncov = a["ncov"].to_numpy()[owner, slot]
+        sig = a["esig"].to_numpy()[owner, slot]
+        # copies of a triangle are computed once (the copy with emult > 0): fill the others
         ncov = ncov[src[inv]]
         sig = sig[src[inv]]
         return {"triangles": np.column_stack([owner, elem]).astype(np.int64),
