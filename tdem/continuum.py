@@ -28,6 +28,7 @@ from physics.materials import JWL, MAT_WIDTH, Fluid
 
 from . import backend
 from .errors import CapacityError, InputError
+from .finite import any_non_finite
 from .integrate import damped_leapfrog
 from .launch import cached
 from .mesh import nodal_masses
@@ -118,7 +119,7 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             nvel[v] = v1
             npos[v] = x1
             s = x1[0] + x1[1] + v1[0] + v1[1]
-            bad = not (s == s) or ti.abs(s) > 1e300
+            bad = any_non_finite(x1) + any_non_finite(v1) > 0 or ti.abs(s) > 1e300
             if not bad:
                 bad = v1.norm() * dt > 0.5 * nsize[v]
             if bad:
