@@ -31,7 +31,7 @@ def _arch_from(name):
 
 
 def _threads_from(threads, source="threads"):
-    if isinstance(threads, str):
+    if isinstance(threads, str) and source != "threads":    # an environment variable
         try:
             threads = int(threads)
         except ValueError:
