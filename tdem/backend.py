@@ -4,51 +4,105 @@ The engine keeps its state in ``ti.ndarray`` objects and its kernels take them a
 arguments, so a kernel is compiled once per process (per dtype) and reused by every
 :class:`tdem.Simulation`, whatever its size. The architecture and the number of CPU
 threads are process-wide Taichi settings: the first simulation decides them
-(``arch`` argument, else ``$TDEM_ARCH``; ``$TDEM_THREADS`` for CPU threads).
+(``arch`` argument, else ``$TDEM_ARCH``; ``$TDEM_THREADS`` for CPU threads), and a
+later simulation asking for others is refused (Taichi is never re-initialised: that
+would free the arrays of the simulations made before).
 """
 import os
+import warnings
 
+import numpy as np
 import taichi as ti
 
 from . import launch
 from .errors import InputError
 
-_state = {"arch": None, "threads": None, "nthreads": None}
+_state = {"arch": None, "asked": None, "threads": None, "nthreads": None}
 
 
 def _arch_from(name):
     if name in ("cpu", "x64", "arm64"):
         return ti.cpu
     if name in ("gpu", "cuda"):
-        return ti.cuda if name == "cuda" else ti.gpu
+        # CUDA only: probing ti.gpu's other backends (OpenGL, GLES) can crash the
+        # process on a machine without them; Taichi falls back from CUDA to the CPU
+        return ti.cuda
     raise InputError(f"arch must be 'cpu' or 'gpu', got {name!r}")
 
 
+def _threads_from(threads, source="threads"):
+    if isinstance(threads, str) and source != "threads":    # an environment variable
+        try:
+            threads = int(threads)
+        except ValueError:
+            raise InputError(f"{source} must be a whole number >= 1, got {threads!r}") from None
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise InputError(f"{source} must be a whole number >= 1, got {threads!r}")
+    return int(threads)
+
+
 def init(arch=None, threads=None):
-    """Initialise Taichi if needed; return the arch name in use ('cpu' or 'gpu')."""
-    name = arch if arch is not None else os.environ.get("TDEM_ARCH", "cpu")
-    name = {"x64": "cpu", "cuda": "gpu"}.get(name, name)
-    _arch_from(name)  # validates
-    if threads is None and os.environ.get("TDEM_THREADS"):
-        threads = int(os.environ["TDEM_THREADS"])
+    """Initialise Taichi if needed; return the arch name in use ('cpu' or 'gpu').
+
+    Taichi is initialised once per process: re-initialising it would invalidate the
+    arrays of every simulation made before. Once it runs, ``None`` means the
+    setting in use, and a different ``arch`` or ``threads`` is refused
+    (:class:`tdem.InputError`). ``arch="gpu"`` without a CUDA GPU runs on the CPU
+    with a warning."""
+    if arch is not None and not isinstance(arch, str):
+        raise InputError(f"arch must be 'cpu' or 'gpu', got {arch!r}")
+    if threads is not None:
+        threads = _threads_from(threads)
     if _state["arch"] is not None:
-        if name == _state["arch"] and (threads is None or threads == _state["threads"]):
-            return name
+        return _same_settings(arch, threads)
+    name = arch if arch is not None else os.environ.get("TDEM_ARCH", "cpu")
+    source = "arch" if arch is not None else "TDEM_ARCH"
+    name = {"x64": "cpu", "cuda": "gpu"}.get(name, name)
+    if name not in ("cpu", "gpu", "arm64"):
+        raise InputError(f"{source} must be 'cpu' or 'gpu', got {name!r}")
+    name = "cpu" if name == "arm64" else name
+    if threads is None and os.environ.get("TDEM_THREADS"):
+        threads = _threads_from(os.environ["TDEM_THREADS"], "TDEM_THREADS")
     kwargs = dict(arch=_arch_from(name), default_fp=ti.f64, default_ip=ti.i32,
                   offline_cache=True, log_level=ti.WARN,
                   kernel_profiler=bool(os.environ.get("TDEM_PROFILE")))
     if threads is not None:
-        if threads < 1:
-            raise InputError(f"threads must be >= 1, got {threads!r}")
-        kwargs["cpu_max_num_threads"] = int(threads)
-    if _state["arch"] is not None:
-        ti.reset()
+        kwargs["cpu_max_num_threads"] = threads
     ti.init(**kwargs)
     launch.reset()
     actual = "gpu" if ti.lang.impl.current_cfg().arch in (ti.cuda, ti.vulkan, ti.metal, ti.opengl) else "cpu"
     _state["arch"] = actual
+    _state["asked"] = name
     _state["threads"] = threads
     _state["nthreads"] = int(ti.lang.impl.current_cfg().cpu_max_num_threads)
+    _warn_fallback(name, actual, 4)
+    return actual
+
+
+def _warn_fallback(asked, actual, stacklevel):
+    if asked == "gpu" and actual == "cpu":
+        warnings.warn("arch='gpu' asked, but no CUDA GPU is available: tdem runs on the CPU",
+                      RuntimeWarning, stacklevel=stacklevel)
+
+
+def _same_settings(arch, threads):
+    """The arch in use, when ``arch`` and ``threads`` agree with the settings Taichi
+    runs with (None agrees with anything); else InputError."""
+    actual = _state["arch"]
+    if arch is not None:
+        name = {"x64": "cpu", "arm64": "cpu", "cuda": "gpu"}.get(arch, arch)
+        if name not in ("cpu", "gpu"):
+            raise InputError(f"arch must be 'cpu' or 'gpu', got {arch!r}")
+        if name != actual and name != _state["asked"]:
+            where = "on the CPU" if actual == "cpu" else "on the GPU"
+            raise InputError(f"arch={arch!r} asked, but Taichi already runs this process "
+                             f"{where} (arch={actual!r}); the architecture is process-wide: "
+                             "set it before the first Simulation")
+        _warn_fallback(name, actual, 5)
+    if threads is not None and actual == "cpu" and threads != _state["nthreads"]:
+        raise InputError(f"threads={threads} asked, but Taichi already runs this process with "
+                         f"threads={_state['nthreads']}; the thread count is process-wide: set "
+                         "it before the first Simulation")
     return actual
 
 

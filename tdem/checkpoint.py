@@ -28,13 +28,15 @@ Layout of the file:
   datasets among ``vx``, ``vy``, ``omega`` that were prescribed.
 """
 import json
+import math
 import warnings
 
 import numpy as np
 
 from .continuum import SAVED as CONTINUUM_SAVED
+from . import mesh as _mesh
 from .errors import InputError
-from .step import WALL_WIDTH
+from .step import W_LAW, WALL_WIDTH
 
 FORMAT = "tdem-checkpoint"
 VERSION = 1
@@ -147,7 +149,8 @@ def save(sim, path):
             cg = f.create_group("continuum")
             for k, arr in sim._cont.a.items():
                 if k in CONTINUUM_SAVED:
-                    cg.create_dataset(k, data=arr.to_numpy())
+                    data = sim._cont.synced_cover() if k == "ncov" else arr.to_numpy()
+                    cg.create_dataset(k, data=data)
             for kind in sim._cont.nr:
                 ng = f.create_group(f"nonreflecting_{kind}")
                 ng.create_dataset("ids", data=sim._cont.a[f"nr{kind}ids"].to_numpy())
@@ -157,51 +160,315 @@ def save(sim, path):
 
 
 
+_CONFIG_KEYS = ("gravity", "dt", "dt_fraction", "precision", "local_damping",
+                "global_damping", "skin", "check_interval", "progress", "laws",
+                "pair_override", "groups", "n", "cap", "capw", "time", "steps", "last_fit",
+                "built")
+
+
+class _Reader:
+    """Reads a checkpoint file; anything missing or unreadable is refused with an
+    InputError naming the file and the item."""
+
+    def __init__(self, f, name):
+        self.f = f
+        self.name = name
+
+    def fail(self, what):
+        raise InputError(f"path: checkpoint {self.name!r} is damaged: {what}")
+
+    def has(self, key, node=None):
+        try:
+            return key in (self.f if node is None else node)
+        except Exception as e:  # h5py raises several types for a broken file
+            self.fail(f"cannot read {key!r} ({type(e).__name__}: {e})")
+
+    def node(self, key, node=None):
+        node = self.f if node is None else node
+        if not self.has(key, node):
+            self.fail(f"it lacks {_item(node, key)!r}")
+        try:
+            return node[key]
+        except Exception as e:
+            self.fail(f"cannot read {_item(node, key)!r} ({type(e).__name__}: {e})")
+
+    def array(self, key, node=None):
+        d = self.node(key, node)
+        try:
+            return np.asarray(d[()])
+        except Exception as e:
+            self.fail(f"cannot read {d.name!r} ({type(e).__name__}: {e})")
+
+    def attr(self, key, node=None, default=KeyError):
+        node = self.f if node is None else node
+        try:
+            if key not in node.attrs:
+                if default is KeyError:
+                    self.fail(f"it lacks the attribute {key!r} of {node.name!r}")
+                return default
+            return node.attrs[key]
+        except InputError:
+            raise
+        except Exception as e:
+            self.fail(f"cannot read the attribute {key!r} ({type(e).__name__}: {e})")
+
+    def keys(self, node):
+        try:
+            return sorted(node)
+        except Exception as e:
+            self.fail(f"cannot list {node.name!r} ({type(e).__name__}: {e})")
+
+
+def _item(node, key):
+    return f"{node.name.rstrip('/')}/{key}" if node.name != "/" else f"/{key}"
+
+
+def _read(path):
+    """Everything :func:`load` needs from the file, as plain Python and numpy."""
+    import os
+
+    import h5py
+    name = str(path)
+    if not os.path.exists(name):
+        raise FileNotFoundError(f"path: no checkpoint file {name!r}")
+    try:
+        f = h5py.File(name, "r")
+    except OSError as e:
+        raise InputError(f"path: {name!r} is not a readable HDF5 file (truncated or "
+                         f"damaged?): {e}") from None
+    r = _Reader(f, name)
+    with f:
+        if r.attr("format", default=None) != FORMAT:
+            raise InputError(f"path: {name!r} is not a tdem checkpoint")
+        version = int(r.attr("version", default=0))
+        if version > VERSION:
+            raise InputError(f"path: checkpoint version {version} is newer than this tdem "
+                             f"reads ({VERSION})")
+        try:
+            cfg = json.loads(r.attr("config"))
+        except (TypeError, ValueError) as e:
+            r.fail(f"its config is not valid JSON ({e})")
+        if not isinstance(cfg, dict):
+            r.fail(f"its config is not a JSON object, got {type(cfg).__name__}")
+        missing = [k for k in _CONFIG_KEYS if k not in cfg]
+        if missing:
+            r.fail(f"its config lacks {', '.join(map(repr, missing))}")
+        st = r.node("state")
+        state = {k: r.array(k, st) for k in r.keys(st)}
+        hg = r.node("host")
+        host = {k: r.array(k, hg) for k in r.keys(hg)}
+        blocks = []
+        bg = r.node("blocks") if r.has("blocks") else None
+        for key in r.keys(bg) if bg is not None else []:
+            g = r.node(key, bg)
+            bfix = []
+            for fk in [x for x in r.keys(g) if x.startswith("fix")]:
+                fg = r.node(fk, g)
+                bfix.append((r.array("ids", fg), *[r.array(nm, fg) if r.has(nm, fg) else None
+                                                   for nm in ("vx", "vy")]))
+            blocks.append((int(r.attr("slot", g)), r.array("vertices", g),
+                           r.array("triangles", g), r.array("velocity", g), bfix,
+                           bool(r.attr("rigid", g, default=False))))
+        cstate = {}
+        if r.has("continuum"):
+            cg = r.node("continuum")
+            cstate = {k: r.array(k, cg) for k in r.keys(cg)}
+        nonref = {}
+        for kind in ("p", "v"):
+            if r.has(f"nonreflecting_{kind}"):
+                g = r.node(f"nonreflecting_{kind}")
+                nonref[kind] = (r.array("ids", g), r.array("coef", g))
+        fixes = []
+        fg = r.node("fixes")
+        for key in r.keys(fg):
+            g = r.node(key, fg)
+            fixes.append((r.array("ids", g), *[r.array(nm, g) if r.has(nm, g) else None
+                                               for nm in _FIX_NAMES]))
+    raw = dict(cfg=cfg, state=state, host=host, blocks=blocks, cstate=cstate, nonref=nonref,
+               fixes=fixes)
+    _check(r, raw)
+    return raw
+
+
+def _first_bad(a):
+    """Index (a tuple) of the first non-finite entry of ``a``, or None."""
+    a = np.asarray(a)
+    if a.dtype.kind not in "fc":
+        return None
+    bad = ~np.isfinite(a)
+    if not bad.any():
+        return None
+    return tuple(int(i) for i in np.argwhere(bad)[0])
+
+
+def _check(r, raw):
+    """Refuse a checkpoint whose parts do not fit together (sizes, indices) or hold
+    NaN or infinite values where the state must be finite."""
+    from . import state as schema
+    cfg, state, host = raw["cfg"], raw["state"], raw["host"]
+
+    def whole(key, lo=0):
+        v = cfg[key]
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            r.fail(f"config {key!r} must be a whole number >= {lo}, got {v!r}")
+        return v
+
+    n, cap, capw = whole("n"), whole("cap", 1), whole("capw", 1)
+    whole("steps")
+    for key in ("time", "dt_fraction"):
+        if not isinstance(cfg[key], (int, float)) or not math.isfinite(cfg[key]):
+            r.fail(f"config {key!r} must be a finite number, got {cfg[key]!r}")
+    if not isinstance(cfg["laws"], list) or not isinstance(cfg["groups"], list):
+        r.fail("config 'laws' and 'groups' must be lists")
+    nlaws = len(cfg["laws"])
+
+    # the particles as added
+    for k in ("sizes", "walls"):
+        if k not in host:
+            r.fail(f"it lacks '/host/{k}'")
+    sizes = host["sizes"]
+    if sizes.ndim != 1 or (sizes.size and (sizes.dtype.kind not in "iu" or sizes.min() < 0)) \
+            or int(sizes.sum()) != n:
+        r.fail(f"'/host/sizes' {sizes.tolist()[:8]} does not add up to its {n} particles")
+    if n:
+        for k, width in (("pos", 2), ("vel", 2), ("radius", 0), ("density", 0), ("law", 0)):
+            if k not in host:
+                r.fail(f"it lacks '/host/{k}'")
+            want = (n, width) if width else (n,)
+            if host[k].shape != want:
+                r.fail(f"'/host/{k}' has shape {host[k].shape}, expected {want} for its {n} "
+                       "particles")
+            bad = _first_bad(host[k])
+            if bad is not None:
+                r.fail(f"'/host/{k}' holds {host[k][bad]} at {list(bad)} (not finite)")
+        if host["law"].size and (host["law"].min() < 0 or host["law"].max() >= max(nlaws, 1)):
+            r.fail(f"'/host/law' holds law ids outside [0, {nlaws})")
+    walls = host["walls"]
+    if walls.ndim != 2 or walls.shape[1] != WALL_WIDTH:
+        r.fail(f"'/host/walls' has shape {walls.shape}, expected (walls, {WALL_WIDTH})")
+    if _first_bad(walls) is not None:
+        r.fail(f"'/host/walls' holds non-finite values (wall {_first_bad(walls)[0]})")
+    wl = walls[:, W_LAW]
+    if len(walls) and (np.any(wl != np.round(wl)) or wl.min() < 0 or wl.max() >= nlaws):
+        r.fail(f"'/host/walls' gives a wall the law {wl.tolist()[:8]}, outside [0, {nlaws})")
+    if n:
+        for k in ("radius", "density"):
+            bad = host[k] <= 0
+            if bad.any():
+                i = int(np.argmax(bad))
+                r.fail(f"'/host/{k}' gives particle {i} the {k} {host[k][i]!r} (must be > 0)")
+
+    for k, gd in enumerate(cfg["groups"]):
+        try:
+            first, count, law = int(gd["first"]), int(gd["count"]), int(gd["law"])
+        except (KeyError, TypeError, ValueError):
+            r.fail(f"config group {k} is {gd!r}, expected first, count and law")
+        if first < 0 or count < 0 or first + count > n or not 0 <= law < nlaws:
+            r.fail(f"config group {k} {gd!r} does not fit its {n} particles and {nlaws} laws")
+    for ids, *vals in raw["fixes"]:
+        if ids.ndim != 1 or ids.dtype.kind not in "iu" or (
+                ids.size and (ids.min() < 0 or ids.max() >= n)):
+            r.fail(f"a prescribed velocity names particles {ids.tolist()[:8]} outside "
+                   f"[0, {n})")
+        for v in vals:
+            if v is not None and _first_bad(v) is not None:
+                r.fail("a prescribed velocity is not finite")
+
+    # the device state: every saved array, sized for n, cap, capw
+    if cfg["built"] and n:
+        lead = {"particle": (n,), "slot": (n, cap), "wall_slot": (n, capw)}
+        for name in schema.saved():
+            if name not in state:
+                r.fail(f"it lacks '/state/{name}'")
+            a, v = schema.BY_NAME[name], state[name]
+            if a.owner in lead:
+                want = lead[a.owner]
+                extra = 0 if a.comps in (0, "i") else 1
+                if v.shape[:len(want)] != want or v.ndim != len(want) + extra or (
+                        isinstance(a.comps, int) and extra and v.shape[-1] != a.comps):
+                    wanted = want + ((a.comps,) if isinstance(a.comps, int) and extra else
+                                     ("k",) if extra else ())
+                    r.fail(f"'/state/{name}' has shape {v.shape}, expected "
+                           f"{tuple(wanted)} for its {n} particles")
+                bad = _first_bad(v)
+                if bad is not None:
+                    what = "particle" if a.owner == "particle" else "entry"
+                    r.fail(f"'/state/{name}' holds {v[bad]} at {list(bad)} (not finite, "
+                           f"{what} {bad[0]})")
+        nwalls = len(walls)
+        for name, lo, hi in (("plaw", 0, max(nlaws, 1) - 1), ("nbr", -1, n - 1),
+                             ("ncnt", 0, cap), ("rcnt", 0, cap), ("wid", -1, nwalls - 1)):
+            v = state[name]
+            if v.dtype.kind not in "iu":
+                r.fail(f"'/state/{name}' holds {v.dtype} numbers, expected integers")
+            out = (v < lo) | (v > hi)
+            if out.any():
+                k = tuple(int(i) for i in np.argwhere(out)[0])
+                r.fail(f"'/state/{name}' holds {int(v[k])} at {list(k)}, outside "
+                       f"[{lo}, {hi}]")
+        for col, what in ((0, "radius"), (1, "mass")):
+            bad = state["prop"][:, col] <= 0
+            if bad.any():
+                k = int(np.argmax(bad))
+                r.fail(f"'/state/prop' gives particle {k} the {what} "
+                       f"{state['prop'][k, col]!r} (must be > 0)")
+        if state["wall"].ndim != 2 or state["wall"].shape[1] != WALL_WIDTH or \
+                state["wall"].shape[0] < len(walls):
+            r.fail(f"'/state/wall' has shape {state['wall'].shape}, expected "
+                   f"({max(len(walls), 1)}, {WALL_WIDTH})")
+        for name, size in (("flags", None), ("gridp", 4), ("gridn", 4)):
+            v = state[name]
+            if v.ndim != 1 or (size is not None and v.shape[0] != size):
+                r.fail(f"'/state/{name}' has shape {v.shape}")
+    elif cfg["built"] and state:
+        r.fail(f"'/state' holds arrays but its config has {n} particles")
+
+    # blocks: meshes, slots
+    nslots = len(cfg.get("slots", []))
+    for k, (slot, x, t, vel, bfix, rigid) in enumerate(raw["blocks"]):
+        if not 0 <= slot < nslots:
+            r.fail(f"block {k} has material slot {slot}, outside [0, {nslots})")
+        try:
+            _mesh.check_mesh(x, t)
+        except InputError as e:
+            r.fail(f"the mesh of block {k}: {e}")
+        if vel.shape != x.shape or _first_bad(vel) is not None:
+            r.fail(f"the velocity of block {k} has shape {vel.shape} or is not finite")
+        for ids, *vals in bfix:
+            if ids.ndim != 1 or ids.dtype.kind not in "iu" or (
+                    ids.size and (ids.min() < 0 or ids.max() >= len(x))):
+                r.fail(f"a prescribed velocity of block {k} names nodes outside "
+                       f"[0, {len(x)})")
+    for key in ("npos", "nvel", "npos0"):
+        if key in raw["cstate"]:
+            bad = _first_bad(raw["cstate"][key])
+            if bad is not None:
+                r.fail(f"'/continuum/{key}' holds {raw['cstate'][key][bad]} at {list(bad)} "
+                       f"(not finite, block node {bad[0]})")
+
+
 def load(path, arch=None):
     """A new :class:`tdem.Simulation` from a checkpoint written by :func:`save`.
 
-    ``arch``: as for :class:`tdem.Simulation` (None: ``$TDEM_ARCH``, else "cpu").
-    The loaded simulation has the same time, step count, particles, contacts (with
-    their history), walls, laws and prescribed velocities, and continues exactly as
-    the saved one would have.
-    """
-    import h5py
+    ``arch``: as for :class:`tdem.Simulation` (None: the one in use, else
+    ``$TDEM_ARCH``, else "cpu"). The loaded simulation has the same time, step count,
+    particles, contacts (with their history), walls, laws and prescribed velocities,
+    and continues exactly as the saved one would have.
 
+    A file that is not a readable tdem checkpoint, or whose parts are missing, do not
+    fit together (array sizes, indices) or hold NaN or infinite values in the state,
+    is refused with :class:`tdem.InputError` (a ``ValueError``) naming the file and
+    what is wrong.
+    """
     from physics.contact_law import ContactLaw
 
     from physics.materials import Material
 
     from .simulation import Block, ParticleGroup, Simulation
 
-    with h5py.File(str(path), "r") as f:
-        if f.attrs.get("format") != FORMAT:
-            raise InputError(f"path: {str(path)!r} is not a tdem checkpoint")
-        version = int(f.attrs.get("version", 0))
-        if version > VERSION:
-            raise InputError(f"path: checkpoint version {version} is newer than this tdem "
-                             f"reads ({VERSION})")
-        cfg = json.loads(f.attrs["config"])
-        state = {k: d[()] for k, d in f["state"].items()}
-        host = {k: f["host"][k][()] for k in f["host"]}
-        blocks = []
-        for key in sorted(f["blocks"]) if "blocks" in f else []:
-            g = f["blocks"][key]
-            bfix = []
-            for fk in sorted(x for x in g if x.startswith("fix")):
-                fg = g[fk]
-                bfix.append((fg["ids"][()], *[fg[nm][()] if nm in fg else None
-                                              for nm in ("vx", "vy")]))
-            blocks.append((int(g.attrs["slot"]), g["vertices"][()], g["triangles"][()],
-                           g["velocity"][()], bfix, bool(g.attrs.get("rigid", False))))
-        cstate = ({k: d[()] for k, d in f["continuum"].items()} if "continuum" in f else {})
-        nonref = {kind: (f[f"nonreflecting_{kind}"]["ids"][()],
-                         f[f"nonreflecting_{kind}"]["coef"][()])
-                  for kind in ("p", "v") if f"nonreflecting_{kind}" in f}
-        fixes = []
-        for key in sorted(f["fixes"]):
-            g = f["fixes"][key]
-            fixes.append((g["ids"][()], *[g[name][()] if name in g else None
-                                          for name in _FIX_NAMES]))
+    raw = _read(path)
+    cfg, state, host, blocks = raw["cfg"], raw["state"], raw["host"], raw["blocks"]
+    cstate, nonref, fixes = raw["cstate"], raw["nonref"], raw["fixes"]
 
     sim = Simulation(gravity=cfg["gravity"], dt=None, dt_fraction=cfg["dt_fraction"],
                      arch=arch, precision=cfg["precision"],
@@ -254,8 +521,13 @@ def load(path, arch=None):
     if sim._cont is not None:
         for k, v in cstate.items():
             arr = sim._cont.a.get(k)
-            if arr is not None and tuple(arr.shape) == v.shape[:len(arr.shape)]:
-                arr.from_numpy(np.ascontiguousarray(v))
+            if arr is None:
+                continue
+            if tuple(arr.shape) != v.shape[:len(arr.shape)]:
+                raise InputError(f"path: checkpoint {str(path)!r} is damaged: "
+                                 f"'/continuum/{k}' has shape {v.shape}, expected "
+                                 f"{tuple(arr.shape)} first")
+            arr.from_numpy(np.ascontiguousarray(v))
         sim._cont.apply_node_fixes(sim._time, initial=True)
         for kind, (ids, coef) in nonref.items():
             sim._cont.set_non_reflecting(kind, ids, coef)

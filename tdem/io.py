@@ -13,10 +13,15 @@ Conventions of the files written here (SI units throughout):
 - A series (:class:`Output`) lists its snapshots in ``particles.pvd``,
   ``walls.pvd`` and ``contacts.pvd`` with the simulated time of each.
 - ``monitors.h5`` holds one group per monitor with datasets ``time`` (s),
-  ``step`` and ``value`` (one row per record).
+  ``step`` and ``value`` (one row per record). A series rewrites it while the run
+  goes on (at most every :attr:`Output.flush_interval` seconds of wall-clock time,
+  when there are new records), at the end of each run and whenever a run stops; each
+  write goes to a temporary file moved into place, so a process killed at any
+  moment leaves a readable file.
 """
 import math
 import os
+import time as _time
 import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -359,6 +364,10 @@ def read_monitors(path):
 
 
 # ------------------------------------------------------------------ series
+# wall-clock seconds between two writes of monitors.h5 while a run goes on
+MONITOR_FLUSH_SECONDS = 1.0
+
+
 class Output:
     """A VTU series with ``.pvd`` indices, monitor histories and abort checkpoints.
 
@@ -368,12 +377,19 @@ class Output:
     neither, only at the end of each run. The state when output is set up is the
     first snapshot. Files in ``directory``: ``particles_KKKKK.vtu``,
     ``walls_KKKKK.vtu``, ``contacts_KKKKK.vtu`` (K: snapshot number), the indices
-    ``particles.pvd``, ``walls.pvd``, ``contacts.pvd``, ``monitors.h5`` (at the end of
-    each run) and, after an interrupted or unstable run, ``last_good.h5`` (a
-    checkpoint of the last good state, see :func:`tdem.checkpoint.load`).
+    ``particles.pvd``, ``walls.pvd``, ``contacts.pvd``, ``monitors.h5`` and, after an
+    interrupted or unstable run, ``last_good.h5`` (a checkpoint of the last good
+    state, see :func:`tdem.checkpoint.load`).
+
+    ``monitors.h5`` is written while the run goes on, at most every
+    ``flush_interval`` seconds of wall-clock time (attribute, default
+    :data:`MONITOR_FLUSH_SECONDS`; 0: at every record) when there are new records,
+    and always at the end of each run and when a run stops (interrupted, unstable, or
+    any error): a process killed outright loses at most the last ``flush_interval``
+    seconds of records.
 
     The engine calls :meth:`next_step`, :meth:`write`, :meth:`truncate`,
-    :meth:`flush` and :meth:`abort`.
+    :meth:`flush`, :meth:`abort` and :meth:`stopped`.
     """
 
     def __init__(self, directory, every=None, interval=None, contacts=True, walls=True,
@@ -408,6 +424,9 @@ class Output:
         self._entries = []          # (step, time, snapshot number), in step order
         self._start = (0, 0.0) if sim is None else (int(sim.steps), float(sim.time))
         self._initial_due = sim is not None
+        self.flush_interval = MONITOR_FLUSH_SECONDS
+        self._monitors_key = None        # the records last written to monitors.h5
+        self._monitors_at = -math.inf    # and when (time.monotonic)
         if sim is not None and _has_bodies(sim):
             self._write_initial(sim)
 
@@ -445,7 +464,10 @@ class Output:
     def next_step(self, sim):
         """The step at which the next snapshot is due (a very large number when none
         is). If output was set up before the simulation had particles, the initial
-        snapshot is written here, at the start of the first run."""
+        snapshot is written here, at the start of the first run. The engine asks after
+        every round of records: new monitor records are written to ``monitors.h5``
+        here when ``flush_interval`` has passed since the last write."""
+        self.write_monitors(sim, force=False)
         if self._initial_due and getattr(sim, "_built", True) and _has_bodies(sim):
             self._write_initial(sim)
         if self.every is not None:
@@ -515,17 +537,38 @@ class Output:
         if self.every is None and self.interval is None and sim.n_particles > 0 and \
                 not (self._entries and self._entries[-1][0] == sim.steps):
             self.write(sim)
+        self.write_monitors(sim)
+
+    def write_monitors(self, sim=None, force=True):
+        """Write ``monitors.h5`` now (``force``), or only if it lacks records and
+        ``flush_interval`` seconds have passed since the last write."""
+        sim = sim if sim is not None else self._sim
+        if sim is None:
+            return
+        mons = getattr(sim, "_monitors", [])
+        key = tuple((m.name, len(m.steps), m.steps[-1] if m.steps else None) for m in mons)
+        now = _time.monotonic()
+        if not force and (key == self._monitors_key or
+                          now - self._monitors_at < float(self.flush_interval)):
+            return
         write_monitors(sim, self.directory / "monitors.h5")
+        self._monitors_key, self._monitors_at = key, now
+
+    def stopped(self, sim):
+        """The run stopped on an error other than an interruption or an instability:
+        write ``monitors.h5`` (a failure to write is a warning, so that the run's own
+        error propagates)."""
+        try:
+            self.write_monitors(sim)
+        except Exception as e:  # noqa: BLE001 - must not hide the run's own error
+            warnings.warn(f"could not write monitors.h5 after the run stopped: {e!r}")
 
     def abort(self, sim, why):
         """The run stopped early (``why``: "interrupted" or "unstable") with the last
         good state in ``sim``: write ``monitors.h5`` and, if ``checkpoint_on_abort``,
         ``last_good.h5`` (its attribute ``abort_reason`` says why). Errors while
         writing are turned into warnings, so that the original error propagates."""
-        try:
-            write_monitors(sim, self.directory / "monitors.h5")
-        except Exception as e:  # noqa: BLE001 - must not hide the run's own error
-            warnings.warn(f"could not write monitors.h5 after the run stopped: {e!r}")
+        self.stopped(sim)
         if not self.checkpoint_on_abort:
             return
         path = self.directory / "last_good.h5"

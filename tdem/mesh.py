@@ -151,9 +151,11 @@ def check_mesh(vertices, triangles, rtol=1e-10):
     """Check a block mesh; return ``(vertices (V, 2) float, triangles (T, 3) int64)``.
 
     Raises :class:`tdem.InputError` for a bad shape, a non-finite coordinate, an
-    index out of range, a repeated vertex in a triangle, or a triangle that is
+    index out of range, a repeated vertex in a triangle, a triangle that is
     **degenerate** (|2S| ≤ rtol × its longest edge squared) or **inverted**
-    (clockwise, S < 0); the message names the first offending triangle.
+    (clockwise, S < 0), and triangles that are duplicated, share an edge with more
+    than one other, or overlap (:func:`check_overlaps`); the message names the
+    offending triangles.
     """
     try:
         x = np.asarray(vertices, dtype=float)
@@ -192,7 +194,149 @@ def check_mesh(vertices, triangles, rtol=1e-10):
         k = int(np.argmax(inverted))
         raise InputError(f"triangle {k} {t[k].tolist()} is inverted (clockwise): "
                          f"area {0.5 * s2[k]!r}")
+    check_overlaps(x, t)
     return x, t
+
+
+def check_overlaps(vertices, triangles, rtol=1e-9):
+    """Refuse triangles that cover the same ground twice, naming them
+    (:class:`tdem.InputError`); the triangles must be counter-clockwise and not
+    degenerate (:func:`check_mesh` calls this after checking that).
+
+    - **duplicated**: two triangles with the same three vertices;
+    - **non-manifold**: an edge shared by more than two triangles;
+    - **folded**: two triangles on the same side of their common edge (they use it
+      in the same direction);
+    - **overlapping**: any two triangles whose interiors intersect (a separating-axis
+      test on the pairs whose bounding boxes meet, found with a grid). Triangles
+      that only touch (a common edge or vertex, a vertex on an edge) are fine; the
+      tolerance is ``rtol`` × the longer edge of the pair.
+    """
+    x = np.asarray(vertices, dtype=float)
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    nt = len(t)
+    if nt < 2:
+        return
+    # duplicated triangles
+    key = np.sort(t, axis=1)
+    inv, cnt = _groups(key, len(x))
+    if (cnt > 1).any():
+        k = int(np.argmax(cnt[inv] > 1))
+        same = np.flatnonzero(inv == inv[k])
+        raise InputError(f"triangles: triangles {_names(same)} are the same triangle "
+                         f"(vertices {key[k].tolist()}); a duplicated triangle counts its "
+                         "mass twice")
+    # edges: directed (a -> b as in the triangle) and undirected
+    e = np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2)
+    owner = np.repeat(np.arange(nt), 3)
+    ekey = np.sort(e, axis=1)
+    einv, ecnt = _groups(ekey, len(x))
+    if (ecnt > 2).any():
+        k = int(np.argmax(ecnt[einv] > 2))
+        tris = owner[einv == einv[k]]
+        raise InputError(f"triangles: the edge {ekey[k].tolist()} is shared by triangles "
+                         f"{_names(tris)}, more than two (the mesh is not manifold)")
+    dinv, dcnt = _groups(e, len(x))
+    if (dcnt > 1).any():
+        k = int(np.argmax(dcnt[dinv] > 1))
+        tris = owner[dinv == dinv[k]]
+        raise InputError(f"triangles: triangles {_names(tris)} overlap: they lie on the same "
+                         f"side of their common edge {e[k].tolist()} (the mesh folds over)")
+    pairs = _overlapping_pairs(x, t, rtol)
+    if len(pairs):
+        i, j = (int(v) for v in pairs[0])
+        more = f" (and {len(pairs) - 1} more pairs)" if len(pairs) > 1 else ""
+        raise InputError(f"triangles: triangles {i} {t[i].tolist()} and {j} {t[j].tolist()} "
+                         f"overlap (their interiors intersect){more}")
+
+
+def _groups(rows, base):
+    """(group of each row, size of each group) for rows of vertex indices < base."""
+    rows = np.asarray(rows, dtype=np.int64)
+    if base ** rows.shape[1] < 2 ** 62:
+        code = np.zeros(len(rows), np.int64)
+        for c in range(rows.shape[1]):
+            code = code * base + rows[:, c]
+        _, inv, cnt = np.unique(code, return_inverse=True, return_counts=True)
+    else:
+        _, inv, cnt = np.unique(rows, axis=0, return_inverse=True, return_counts=True)
+    return inv.ravel(), cnt
+
+
+def _names(idx):
+    idx = [int(i) for i in idx]
+    return ", ".join(map(str, idx[:-1])) + f" and {idx[-1]}" if len(idx) > 1 else str(idx[0])
+
+
+def _candidate_pairs(lo, hi):
+    """Pairs (i < j) of boxes [lo, hi] that may meet: those sharing a grid cell."""
+    nt = len(lo)
+    ext = np.max(hi - lo, axis=1)
+    h = float(np.median(ext))
+    if not h > 0:
+        h = float(ext.max()) or 1.0
+    origin = lo.min(axis=0)
+    while True:
+        c0 = np.floor((lo - origin) / h).astype(np.int64)
+        c1 = np.floor((hi - origin) / h).astype(np.int64)
+        span = c1 - c0 + 1
+        ncell = span[:, 0] * span[:, 1]
+        if ncell.sum() <= 16 * nt + 1024:
+            break
+        h *= 2.0
+    total = int(ncell.sum())
+    tri = np.repeat(np.arange(nt), ncell)
+    local = np.arange(total) - np.repeat(np.cumsum(ncell) - ncell, ncell)
+    cx = c0[tri, 0] + local % span[tri, 0]
+    cy = c0[tri, 1] + local // span[tri, 0]
+    cell = cx * (int(c1[:, 1].max()) + 1) + cy
+    order = np.argsort(cell, kind="stable")
+    cell, tri = cell[order], tri[order]
+    start = np.flatnonzero(np.r_[True, cell[1:] != cell[:-1]])
+    size = np.diff(np.r_[start, total])
+    group_end = np.repeat(start + size, size)
+    npart = group_end - 1 - np.arange(total)            # partners after each entry
+    p = np.repeat(np.arange(total), npart)
+    q = p + 1 + (np.arange(len(p)) - np.repeat(np.cumsum(npart) - npart, npart))
+    a, b = tri[p], tri[q]
+    # a pair of boxes sharing several cells is kept in one of them: the cell of the
+    # corner max(lower-left cells), which both boxes cover
+    cp, cq = cx[order][p], cy[order][p]
+    keep = (cp == np.maximum(c0[a, 0], c0[b, 0])) & (cq == np.maximum(c0[a, 1], c0[b, 1]))
+    a, b = a[keep], b[keep]
+    return np.stack([np.minimum(a, b), np.maximum(a, b)], axis=1)
+
+
+def _overlapping_pairs(x, t, rtol, chunk=200000):
+    p = x[t]                                           # (T, 3, 2)
+    lo, hi = p.min(axis=1), p.max(axis=1)
+    cand = _candidate_pairs(lo, hi)
+    if len(cand) == 0:
+        return cand
+    edge = np.roll(p, -1, axis=1) - p                   # (T, 3, 2)
+    elen = np.linalg.norm(edge, axis=2)
+    normal = np.stack([-edge[:, :, 1], edge[:, :, 0]], axis=2) / elen[:, :, None]
+    longest = elen.max(axis=1)
+    found = []
+    for s in range(0, len(cand), chunk):
+        i, j = cand[s:s + chunk, 0], cand[s:s + chunk, 1]
+        tol = rtol * np.maximum(longest[i], longest[j])
+        meet = np.all((np.minimum(hi[i], hi[j]) - np.maximum(lo[i], lo[j])) > tol[:, None],
+                      axis=1)
+        i, j, tol = i[meet], j[meet], tol[meet]
+        if len(i) == 0:
+            continue
+        axes = np.concatenate([normal[i], normal[j]], axis=1)          # (P, 6, 2)
+        pa = np.einsum("pak,pvk->pav", axes, p[i])                     # (P, 6, 3)
+        pb = np.einsum("pak,pvk->pav", axes, p[j])
+        gap = np.minimum(pa.max(axis=2), pb.max(axis=2)) - np.maximum(pa.min(axis=2),
+                                                                      pb.min(axis=2))
+        hit = np.all(gap > tol[:, None], axis=1)
+        found.append(np.stack([i[hit], j[hit]], axis=1))
+    if not found:
+        return np.zeros((0, 2), np.int64)
+    found = np.concatenate(found)
+    return found[np.lexsort((found[:, 1], found[:, 0]))]
 
 
 def boundary_edges(triangles):

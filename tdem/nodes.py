@@ -7,6 +7,7 @@ and the dashpots of non-reflecting boundaries (on particles or block nodes).
 """
 import taichi as ti
 
+from .finite import any_non_finite
 from .integrate import damped_leapfrog
 from .launch import cached
 from .step import P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY
@@ -53,7 +54,7 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             nvel[v] = v1
             npos[v] = x1
             s = x1[0] + x1[1] + v1[0] + v1[1]
-            bad = not (s == s) or ti.abs(s) > 1e300
+            bad = any_non_finite(x1) + any_non_finite(v1) > 0 or ti.abs(s) > 1e300
             if not bad:
                 bad = v1.norm() * dt > 0.5 * nsize[v]
             if bad:

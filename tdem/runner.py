@@ -482,6 +482,10 @@ class Runner:
         except InstabilityError:
             self._on_abort("unstable")
             raise
+        except Exception:
+            if self._output is not None:
+                self._output.stopped(self)
+            raise
         finally:
             if bar is not None:
                 bar.close()
@@ -522,6 +526,7 @@ class Runner:
     def _find_instability(self):
         """Replay the last segment one step at a time to name the failing step."""
         self._restore_snapshot()
+        self._plan_events()
         sargs, rargs = self._engine_args()
         host_flag = self._host_reads_flag
         for _ in range(self.check_interval + 1):
@@ -551,6 +556,8 @@ class Runner:
                     f"(dt = {self._dt_run:.3g} s). The last good state (step {self._steps}) is "
                     "kept; reduce dt_fraction or check stiffnesses.",
                     step=step, time=t, particle=k)
+            if self._steps >= self._next_event:   # the records of the good steps
+                self._events()
         self._restore_snapshot()
         raise InstabilityError("unstable run (could not isolate the step)")
 

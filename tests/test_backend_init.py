@@ -1,0 +1,92 @@
+"""Taichi is initialised once per process: arch="gpu" without a GPU falls back to the
+CPU with a warning, and a later simulation asking for another thread count or
+architecture is refused instead of re-initialising Taichi (which would free the
+arrays of every simulation made before). Each test runs in a child process, which
+initialises Taichi itself."""
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+import tdem
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _child(code, **env):
+    e = dict(os.environ)
+    e.pop("TDEM_ARCH", None)
+    e.pop("TDEM_THREADS", None)
+    e.update(env)
+    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, env=e,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_gpu_without_a_gpu_runs_on_the_cpu_with_a_warning():
+    r = _child("""
+        import warnings
+        import tdem
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            sim = tdem.Simulation(arch="gpu", gravity=(0.0, 0.0), progress=False)
+        sim.add_particles([[0.0, 0.0], [0.25, 0.0]], 0.1, contact=tdem.LinearContact(kn=1e6))
+        sim.run(steps=5)
+        print("ARCH", sim.arch)
+        for x in w:
+            print("WARNING", x.category.__name__, x.message)
+        """)
+    assert r.returncode == 0, r.stderr[-2000:]
+    if "ARCH cpu" in r.stdout:
+        assert ("WARNING RuntimeWarning arch='gpu' asked, but no CUDA GPU is available: "
+                "tdem runs on the CPU") in r.stdout
+    else:  # a machine with a CUDA GPU
+        assert "ARCH gpu" in r.stdout and "WARNING" not in r.stdout
+
+
+def test_other_threads_or_arch_refused_once_taichi_runs():
+    r = _child("""
+        import numpy as np
+        import tdem
+        sim = tdem.Simulation(threads=2, gravity=(0.0, -9.81), progress=False)
+        sim.add_particles([[0.0, 0.0], [0.25, 0.0]], 0.1, contact=tdem.LinearContact(kn=1e6))
+        sim.run(steps=10)
+        for kwargs in ({"threads": 1}, {"threads": 3}, {"arch": "gpu"}):
+            try:
+                tdem.Simulation(**kwargs)
+                print("ACCEPTED", kwargs)
+            except tdem.InputError as e:
+                print("REFUSED", e)
+        # the same settings, or none, are fine; the first simulation still runs
+        tdem.Simulation(threads=2, arch="cpu")
+        tdem.Simulation()
+        sim.run(steps=10)
+        y = sim.particles.numpy()["position"][:, 1]
+        print("Y", np.allclose(y, -0.5 * 9.81 * sim.time ** 2, rtol=0.2))
+        """)
+    assert r.returncode == 0, r.stderr[-2000:]
+    out = r.stdout
+    assert "ACCEPTED" not in out
+    assert ("REFUSED threads=1 asked, but Taichi already runs this process with threads=2; "
+            "the thread count is process-wide: set it before the first Simulation") in out
+    assert "REFUSED threads=3 asked, but Taichi already runs this process with threads=2" in out
+    assert ("REFUSED arch='gpu' asked, but Taichi already runs this process on the CPU "
+            "(arch='cpu')") in out
+    assert "Y True" in out
+
+
+def test_bad_thread_counts_are_named():
+    with pytest.raises(tdem.InputError, match=r"threads must be a whole number >= 1, got 0"):
+        tdem.Simulation(threads=0)
+    with pytest.raises(tdem.InputError, match=r"threads must be a whole number >= 1, got 'two'"):
+        tdem.Simulation(threads="two")
+    r = _child("""
+        import tdem
+        try:
+            tdem.Simulation()
+        except tdem.InputError as e:
+            print("REFUSED", e)
+        """, TDEM_THREADS="many")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "REFUSED TDEM_THREADS must be a whole number >= 1, got 'many'" in r.stdout
