@@ -30,7 +30,7 @@ import taichi as ti
 from tdem.launch import cached
 
 from . import fvm
-from .materials import mc_correct_state
+from .materials import MAT_G, MAT_K, mc_correct_state
 from .pcmm import viscous_stress
 
 
@@ -54,7 +54,7 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
             de = fvm.strain_increment(grad, dt)
             M = tmat[e]
             sig = fvm.jaumann_rotate(tsig[e], fvm.spin_rate(grad), dt) + fvm.elastic_increment(
-                de, matp[M, 2], matp[M, 3])
+                de, matp[M, MAT_K], matp[M, MAT_G])
             st = tstate[e]
             sig, eps, flag = mc_correct_state(sig, matp, M, ti.cast(st[1] > 0.0, ti.i32))
             tsig[e] = sig

@@ -117,6 +117,13 @@ from tdem.errors import InputError
 from .validate import in_range, non_negative, positive
 
 MAT_WIDTH = 17
+# the columns of a material row (module docstring: the material table)
+(MAT_TYPE, MAT_RHO, MAT_K, MAT_G, MAT_COH, MAT_TEN, MAT_NPHI, MAT_NPSI, MAT_BRITTLE,
+ MAT_COH_R, MAT_TEN_R, MAT_VISC, MAT_B1, MAT_B2, MAT_SQ_NPHI, MAT_AP,
+ MAT_DEPS) = range(MAT_WIDTH)
+MAT_EOS = MAT_COH          # a Fluid row: 1 with the equation of state
+# a JWL row's columns 4-10
+JWL_A, JWL_B, JWL_R1, JWL_R2, JWL_OMEGA, JWL_E0, JWL_D = range(4, 11)
 ELASTIC, MOHR_COULOMB, FLUID, JWL_TYPE = 0, 1, 2, 3
 NO_FAILURE, SHEAR_FAILURE, TENSION_FAILURE = 0, 1, 2
 
@@ -449,7 +456,8 @@ class JWL(Material):
 @ti.func
 def jwl_pressure(matp: ti.template(), M, V, E):
     """Eq. 25 of the JWL row M at relative volume V and energy E (per initial volume)."""
-    A, B, R1, R2, w = matp[M, 4], matp[M, 5], matp[M, 6], matp[M, 7], matp[M, 8]
+    A, B, R1, R2, w = (matp[M, JWL_A], matp[M, JWL_B], matp[M, JWL_R1], matp[M, JWL_R2],
+                       matp[M, JWL_OMEGA])
     return (A * (1.0 - w / (R1 * V)) * ti.exp(-R1 * V)
             + B * (1.0 - w / (R2 * V)) * ti.exp(-R2 * V) + w * E / V)
 
@@ -457,7 +465,7 @@ def jwl_pressure(matp: ti.template(), M, V, E):
 @ti.func
 def fluid_pressure(matp: ti.template(), M, V):
     """Equation of state of the Fluid row M at relative volume V (:class:`Fluid`)."""
-    return ti.max(matp[M, 2] * (1.0 / V - 1.0), -matp[M, 5])
+    return ti.max(matp[M, MAT_K] * (1.0 / V - 1.0), -matp[M, MAT_TEN])
 
 
 # ------------------------------------------------------------------ kernel side
@@ -624,18 +632,18 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
     out = s
     eps = 0.0
     flag = NO_FAILURE
-    kind = ti.cast(matp[M, 0], ti.i32)
+    kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
     if kind == MOHR_COULOMB:
-        K = matp[M, 2]
-        G = matp[M, 3]
-        coh = matp[M, 4]
-        ten = matp[M, 5]
-        if failed != 0 and matp[M, 8] != 0.0:
-            coh = matp[M, 9]
-            ten = matp[M, 10]
-        nphi = matp[M, 6]
-        npsi = matp[M, 7]
-        sq = matp[M, 14]
+        K = matp[M, MAT_K]
+        G = matp[M, MAT_G]
+        coh = matp[M, MAT_COH]
+        ten = matp[M, MAT_TEN]
+        if failed != 0 and matp[M, MAT_BRITTLE] != 0.0:
+            coh = matp[M, MAT_COH_R]
+            ten = matp[M, MAT_TEN_R]
+        nphi = matp[M, MAT_NPHI]
+        npsi = matp[M, MAT_NPSI]
+        sq = matp[M, MAT_SQ_NPHI]
         a1 = K + 4.0 * G / 3.0
         a2 = K - 2.0 * G / 3.0
         # in-plane principal values a ≤ b, direction (cos 2θ, sin 2θ) of b
@@ -660,7 +668,7 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
             scale = ti.abs(p[0]) + ti.abs(p[1]) + ti.abs(p[2]) + coh + ten
             tol = 1e-12 * scale
             # FLAC's domain split
-            ap = matp[M, 15]
+            ap = matp[M, MAT_AP]
             sp = ten * nphi - 2.0 * coh * sq
             h = s3 - ten + ap * (s1 - sp)
             # FLAC's one-plane return, in closed form: Δγ = F/(n·D m), q = p − Δγ D m
@@ -677,7 +685,7 @@ def mc_correct_state(s, matp: ti.template(), M, failed):
                 d3 = d2 + (a1 - a2) * npsi
                 g1 = -fs / (nphi * d3 - d1)
                 # Δe^ps = Δγ·sqrt(½ |m − mean(m)|²), m = (−1, N_ψ, 0) by rank
-                eps = g1 * matp[M, 16]
+                eps = g1 * matp[M, MAT_DEPS]
                 flag = SHEAR_FAILURE
             else:
                 # tension plane i3: F = s_i3 − T, m_i3 = 1

@@ -31,6 +31,7 @@ import taichi as ti
 from physics.contact_law import zero_history
 
 from .launch import cached
+from .state import PROP_RADIUS
 
 # indices in the int status array ``flags``
 F_REBUILD = 0    # 1: lists must be rebuilt before the next force computation
@@ -123,7 +124,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
     for i in range(n):
         if flags[F_REBUILD] != 0:
             xi = pos[i]
-            ri = prop[i][0]
+            ri = prop[i][PROP_RADIUS]
             cx, cy = cell_of(xi, gridp, nx, ny)
             cnt = 0
             back = 0
@@ -137,7 +138,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                             j = sorted_ids[s]
                             if j != i:
                                 d = pos[j] - xi
-                                cut = ri + prop[j][0] + skin
+                                cut = ri + prop[j][PROP_RADIUS] + skin
                                 if d.dot(d) < cut * cut:
                                     if j > i:
                                         if cnt < cap:
@@ -192,7 +193,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                 wid_old[i, s] = wid[i, s]
                 whist_old[i, s] = whist[i, s]
             xi = pos[i]
-            cut = prop[i][0] + skin
+            cut = prop[i][PROP_RADIUS] + skin
             cnt = 0
             for w in range(nwalls):
                 a = ti.Vector([wall[w, 0], wall[w, 1]])
@@ -239,4 +240,4 @@ def bounds(pos: ti.types.ndarray(), prop: ti.types.ndarray(), out: ti.types.ndar
             ti.atomic_min(out[1], x[1])
             ti.atomic_max(out[2], x[0])
             ti.atomic_max(out[3], x[1])
-        ti.atomic_max(out[4], prop[i][0])
+        ti.atomic_max(out[4], prop[i][PROP_RADIUS])

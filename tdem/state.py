@@ -45,6 +45,10 @@ class Array:
     doc: str = ""
 
 
+# columns of the particle property vector ``prop``
+PROP_RADIUS, PROP_MASS, PROP_INERTIA = 0, 1, 2
+PROP_WIDTH = 3
+
 # sizes a shape may name: n, cap, capw, walls (>= 1), laws, law_width, cells,
 # cell_starts; and fixed numbers
 ENGINE = (
@@ -52,7 +56,8 @@ ENGINE = (
     Array("pos", "particle", 2, "f", "dynamic", doc="position x_n (m)"),
     Array("vel", "particle", 2, "f", "dynamic", doc="velocity v_{n-1/2} (m/s)"),
     Array("omega", "particle", 0, "f", "dynamic", doc="spin (rad/s)"),
-    Array("prop", "particle", 3, "f", "setup", doc="radius (m), mass (kg/m), inertia"),
+    Array("prop", "particle", PROP_WIDTH, "f", "setup",
+          doc="radius (m), mass (kg/m), inertia (kg m²/m): columns PROP_*"),
     Array("plaw", "particle", "i", "i32", "setup", doc="law group of the particle"),
     Array("fix", "particle", "i", "i32", "setup", doc="prescribed-velocity bits (step.FIX_*)"),
     Array("vfix", "particle", 3, "f", "setup", doc="prescribed vx, vy, omega"),

@@ -24,6 +24,7 @@ from .finite import any_non_finite, non_finite
 from .integrate import damped_leapfrog
 from .launch import cached
 from .neighbors import F_BAD, F_REBUILD, slot_bits
+from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
 # columns of the float parameter array ``simp``
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
@@ -58,7 +59,7 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     U0 = ti.static(R + 3)
     j = nbr[i, k]
     pj = prop[j]
-    rj = pj[0]
+    rj = pj[PROP_RADIUS]
     d, dist, u_geo = disc_disc.overlap(xi, pos[j], ri, rj)
     # a pair that shared PCMM elements until recently counts its overlap from the
     # overlap it had when they stopped carrying it (hist[U0], recorded by
@@ -76,7 +77,7 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         n, t, ai, aj, vrel = disc_disc.kinematics(d, dist, u, ri, rj, vi, vel[j], wi, wj)
         vn = vrel.dot(n)
         L = lawpair[li, plaw[j]]
-        mj = pj[1]
+        mj = pj[PROP_MASS]
         reff = ri * rj / (ri + rj)
         fn_el, fn, ft, kn, cnd, d1, h = law_force(
             laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h)
@@ -116,7 +117,7 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
     the law's columns, then the rolling couple, rotation and broken flag."""
     R = ti.static(history_width(laws))
     xi = pos[i]
-    ri = prop[i][0]
+    ri = prop[i][PROP_RADIUS]
     diss = 0.0
     work = 0.0
     ftot = ti.Vector([0.0, 0.0])
@@ -138,7 +139,7 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             L = ti.cast(wall[w, W_LAW], ti.i32)
             h = whist[i, s]
             fn_el, fn, ft, kn, cnd, d1, h = law_force(
-                laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][1], ri, dt, h)
+                laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri, dt, h)
             fs_tot = ft[0]
             m, m_tot, th, brk, d2r = rolling_couple(
                 lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[R], h[R + 1], h[R + 2])
@@ -253,11 +254,12 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if skip == 2:
                     # a same-body pair at the start: the contact law counts from now
                     j = nbr[i, k]
-                    u = pi[0] + prop[j][0] - (pos[j] - xi).norm()
+                    u = pi[PROP_RADIUS] + prop[j][PROP_RADIUS] - (pos[j] - xi).norm()
                     h0 = hist[i, k]
                     h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
                     hist[i, k] = h0
-                fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[0], pi[1], li, pos, vel,
+                fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS],
+                                               li, pos, vel,
                                                omega, prop, plaw, lawp, lawpair, nbr, hist, cn,
                                                cs, dt, detail, laws)
             f += fk
@@ -305,8 +307,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     tq += c[2]
         if ti.static(continuum):
             f += xforce[i]
-        m = prop[i][1]
-        inertia = prop[i][2]
+        m = prop[i][PROP_MASS]
+        inertia = prop[i][PROP_INERTIA]
         v0 = vel[i]
         w0 = omega[i]
         ftot = f + m * g
@@ -389,7 +391,7 @@ def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
         # a bit test: under fast math, `s != s` is folded to False (tdem.finite)
         bad = any_non_finite(x) + any_non_finite(v) + non_finite(w) > 0 or ti.abs(s) > 1e300
         if not bad:
-            bad = v.norm() * dt > 0.5 * prop[i][0]
+            bad = v.norm() * dt > 0.5 * prop[i][PROP_RADIUS]
         if bad:
             ti.atomic_min(flags[F_BAD], i)
 
@@ -406,12 +408,12 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
     R = ti.static(history_width(laws))
     total = 0.0
     for i in range(pos.shape[0]):
-        ri = prop[i][0]
+        ri = prop[i][PROP_RADIUS]
         for k in range(ncnt[i]):
             u = cs[i, k][2]
             if u > 0.0:
                 j = nbr[i, k]
-                rj = prop[j][0]
+                rj = prop[j][PROP_RADIUS]
                 L = lawpair[plaw[i], plaw[j]]
                 h = hist[i, k]
                 reff = ri * rj / (ri + rj)
@@ -441,7 +443,7 @@ def particle_stress(prop: ti.types.ndarray(), nbr: ti.types.ndarray(),
     cap = nbr.shape[1]
     bits = slot_bits(cap)
     for i in range(prop.shape[0]):
-        ri = prop[i][0]
+        ri = prop[i][PROP_RADIUS]
         s = ti.Matrix([[0.0, 0.0], [0.0, 0.0]])
         for k in range(ncnt[i]):
             u = cs[i, k][2]

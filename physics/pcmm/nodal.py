@@ -10,9 +10,10 @@ Same-body Fluid and JWL neighbours repel through :func:`fluid_core_force`.
 import taichi as ti
 
 from tdem.launch import cached
+from tdem.state import PROP_RADIUS
 
 from ..contact_law import zero_history
-from ..materials import FLUID, JWL_TYPE
+from ..materials import FLUID, JWL_TYPE, MAT_K, MAT_TYPE
 from .layout import P_BUILT, P_NEW
 from .stress import _corner_force, _has_eos, _unpack2
 
@@ -74,7 +75,7 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 psum += ti.abs(ep)
                 if failed:
                     hit = 1
-            kind_i = ti.cast(matp[pmat[i], 0], ti.i32)
+            kind_i = ti.cast(matp[pmat[i], MAT_TYPE], ti.i32)
             fluid = kind_i == FLUID or kind_i == JWL_TYPE
             if redo:
                 # pair slots of same-body Eq. 1 neighbours (both lists sorted)
@@ -140,7 +141,7 @@ def _set_skip(i, k, j, skip, pos: ti.template(), prop: ti.template(), cskip: ti.
             h[u0] = CARRIED
             hist[i, k] = h
     elif h[u0] < 0.0:
-        u = prop[i][0] + prop[j][0] - (pos[j] - pos[i]).norm()
+        u = prop[i][PROP_RADIUS] + prop[j][PROP_RADIUS] - (pos[j] - pos[i]).norm()
         h = zero_history(h)
         h[u0] = ti.max(u, 0.0)
         hist[i, k] = h
@@ -174,5 +175,5 @@ def fluid_core_force(matp: ti.template(), M, xi, xj, rsum):
     dc = FLUID_CORE * rsum
     out = ti.Vector([0.0, 0.0])
     if L < dc and L > 0.0:
-        out = -matp[M, 2] * (dc - L) / L * d
+        out = -matp[M, MAT_K] * (dc - L) / L * d
     return out

@@ -14,7 +14,8 @@ import taichi as ti
 from tdem.launch import cached
 
 from .. import fvm
-from ..materials import FLUID, JWL_TYPE, fluid_pressure, jwl_pressure, mc_correct_state
+from ..materials import (FLUID, JWL_D, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS, MAT_G, MAT_K, MAT_RHO,
+                         MAT_TYPE, MAT_VISC, fluid_pressure, jwl_pressure, mc_correct_state)
 from .layout import P_NEW, P_RECOUNT, P_SOFT
 from .rebuild import SLACK_FLOOR
 from .rules import _cover_incident, _sorted3
@@ -189,7 +190,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     ebud[a, s] -= uw
                 grad, de, area = _kinematics(a, b, c, pos, vel, dt)
                 M = pmat[a]
-                kind = ti.cast(matp[M, 0], ti.i32)
+                kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
                 sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
                 eps = 0.0
                 flag = 0
@@ -203,7 +204,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     if not found:
                         sig = (psig[a] + psig[b] + psig[c]) / 3.0
                     sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
-                        de, matp[M, 2], matp[M, 3])
+                        de, matp[M, MAT_K], matp[M, MAT_G])
                     failed = 0
                     if pfail[a] + pfail[b] + pfail[c] > 0:
                         failed = 1
@@ -286,10 +287,10 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                 js = pjwl[i]
                 V0 = js[4]
                 V = js[0] + thsum / (3.0 * V0)
-                if ti.cast(matp[M, 0], ti.i32) == JWL_TYPE:
+                if ti.cast(matp[M, MAT_TYPE], ti.i32) == JWL_TYPE:
                     F = 0.0
                     if time >= js[2]:
-                        F = ti.min(1.0, (time - js[2]) * matp[M, 10] / (3.0 * rad[i]))
+                        F = ti.min(1.0, (time - js[2]) * matp[M, JWL_D] / (3.0 * rad[i]))
                     E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
                     p = F * jwl_pressure(matp, M, V, E)
                     pjwl[i] = ti.Vector([V, E, js[2], p, V0])
@@ -322,13 +323,13 @@ def bulk_viscosity(matp: ti.template(), M, de, dt, area):
     docstring of :mod:`physics.materials`), for a shrinking element only."""
     q = 0.0
     th = de[0] + de[1]
-    b1 = matp[M, 12]
-    b2 = matp[M, 13]
+    b1 = matp[M, MAT_B1]
+    b2 = matp[M, MAT_B2]
     if th < 0.0 and b1 + b2 > 0.0:
         L = ti.sqrt(ti.abs(area))
         rate = -th / dt
-        rho = matp[M, 1]
-        c = ti.sqrt((matp[M, 2] + 4.0 * matp[M, 3] / 3.0) / rho)
+        rho = matp[M, MAT_RHO]
+        c = ti.sqrt((matp[M, MAT_K] + 4.0 * matp[M, MAT_G] / 3.0) / rho)
         q = rho * L * rate * (b1 * c + b2 * L * rate)
     return q
 
@@ -337,8 +338,8 @@ def bulk_viscosity(matp: ti.template(), M, de, dt, area):
 def _has_eos(matp: ti.template(), M):
     """Whether material row M keeps its pressure per particle: JWL, or a Fluid with
     ``equation_of_state`` (column 4 = 1)."""
-    kind = ti.cast(matp[M, 0], ti.i32)
-    return kind == JWL_TYPE or (kind == FLUID and matp[M, 4] > 0.0)
+    kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
+    return kind == JWL_TYPE or (kind == FLUID and matp[M, MAT_EOS] > 0.0)
 
 
 @ti.func
@@ -346,7 +347,7 @@ def viscous_stress(matp: ti.template(), M, de, dt):
     """Viscous stress 2μ·dev(D) of a Fluid row (μ in column 11), D = Δε/Δt in plane
     strain (D_zz = 0); zero for other materials. Not accumulated: it acts on the
     forces of the step only."""
-    mu = matp[M, 11]
+    mu = matp[M, MAT_VISC]
     out = ti.Vector([0.0, 0.0, 0.0, 0.0])
     if mu > 0.0:
         tr = (de[0] + de[1]) / 3.0
