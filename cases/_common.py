@@ -20,9 +20,14 @@ CASES_DIR = Path(__file__).resolve().parent
 
 
 # ---------------------------------------------------------------- command line
+# how the case was started, for its usage line (``tdem run`` sets "tdem run NAME")
+COMMAND = None
+
+
 def parser(case, description=None):
     """The options every case takes: --preset, --arch, --out, --threads."""
-    p = argparse.ArgumentParser(prog=f"python -m cases.{case}", description=description,
+    p = argparse.ArgumentParser(prog=COMMAND or f"python -m cases.{case}",
+                                description=description,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--preset", choices=PRESETS, default="quick",
                    help="quick: coarse, a minute or two on 2 CPU cores; "
@@ -45,13 +50,26 @@ def parse(case, argv=None, description=None, extra=None):
     args = p.parse_args(argv)
     if args.threads is not None and args.threads < 1:
         p.error(f"--threads must be >= 1, got {args.threads}")
-    out = output_dir(case, args.out)
+    try:
+        out = output_dir(case, args.out)
+    except OSError as e:
+        p.error(f"--out {args.out or out_default(case)}: cannot write there "
+                f"({e.strerror or e})")
     return args, out
 
 
+def out_default(case):
+    return str(Path("out") / case)
+
+
 def output_dir(case, out=None):
+    """The output folder, created; OSError where it cannot be (a file of that name, no
+    permission)."""
     path = Path(out) if out else Path("out") / case
     path.mkdir(parents=True, exist_ok=True)
+    probe = path / ".tdem-write-test"
+    probe.write_bytes(b"")
+    probe.unlink()
     return path
 
 

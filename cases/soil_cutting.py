@@ -149,8 +149,9 @@ def build(cfg, arch=None, threads=None):
 
     corners, u = blade_outline(R)
     v, t = tdem.mesh.polygon(corners, cfg["mesh_size"])
-    blade = sim.add_block(v, t, material=tdem.Elastic(STEEL["density"], STEEL["young"],
-                                                      STEEL["poisson"]))
+    blade = sim.add_block(v, t, material=tdem.Elastic(density=STEEL["density"],
+                                                      young=STEEL["young"],
+                                                      poisson=STEEL["poisson"]))
     t0 = cfg["settle"]
     speed = cfg["speed"]
 

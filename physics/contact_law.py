@@ -207,6 +207,13 @@ class ContactLaw:
         (numbers or numpy arrays), for the critical time step."""
         raise NotImplementedError(f"{type(self).__name__} must define critical_stiffness")
 
+    def critical_stiffnesses(self, radius, mass):
+        """(normal, shear) stiffness the law reaches for particles of this radius and
+        mass, for the stable step of a dense packing (:mod:`physics.stability`); by
+        default both the :meth:`critical_stiffness` (an upper bound)."""
+        k = self.critical_stiffness(radius, mass)
+        return k, k
+
     def update(self, **params):
         """Change parameters, validated as in the constructor (e.g.
         ``law.update(friction=0.0)``). A simulation using the law takes the new values
@@ -224,6 +231,10 @@ class ContactLaw:
     def _set_common(self, friction, cohesion, restitution, damping_ratio, rolling):
         """Friction, cohesion and damping shared by the built-in laws, validated."""
         self.friction = non_negative("friction", friction)
+        if self.friction > 10.0:
+            raise InputError(f"friction is the coefficient mu = tan(phi), at most 10, got "
+                             f"{friction!r} (an angle in degrees? tan({friction!r}°) = "
+                             f"{math.tan(math.radians(min(self.friction, 89.9))):.3g})")
         self.cohesion = non_negative("cohesion", cohesion)
         self.damping_ratio = non_negative("damping_ratio", damping_ratio)
         self._gamma = 0.0

@@ -27,7 +27,7 @@ class HertzMindlin(ContactLaw):
     history = ("shear",)
     tangential = ("shear",)
 
-    def __init__(self, young, poisson, friction=0.5, restitution=None, cohesion=0.0,
+    def __init__(self, *, young, poisson, friction=0.5, restitution=None, cohesion=0.0,
                  damping_ratio=0.0, rolling=None):
         self.young = positive("young", young)
         self.poisson = in_range("poisson", poisson, -1.0, 0.5, lo_open=True, hi_open=True)
@@ -63,5 +63,9 @@ class HertzMindlin(ContactLaw):
 
     def critical_stiffness(self, radius, mass):
         """Tangent stiffness at an overlap of 5 % of the radius (a conservative bound)."""
+        kn, ks = self.critical_stiffnesses(radius, mass)
+        return np.maximum(kn, ks)
+
+    def critical_stiffnesses(self, radius, mass):
         a = (0.5 * 0.05) ** 0.5 * np.asarray(radius, dtype=float)   # sqrt(R* u), R* = R/2
-        return np.maximum(2.0 * self.e_star * a, 8.0 * self.g_star * a)
+        return 2.0 * self.e_star * a, 8.0 * self.g_star * a

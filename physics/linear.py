@@ -43,7 +43,7 @@ class LinearContact(ContactLaw):
     history = ("shear",)
     tangential = ("shear",)
 
-    def __init__(self, kn, ks=None, friction=0.5, cohesion=0.0, restitution=None,
+    def __init__(self, *, kn, ks=None, friction=0.5, cohesion=0.0, restitution=None,
                  damping_ratio=0.0, rolling=None):
         self.kn = positive("kn", kn)
         if ks is None:
@@ -58,6 +58,9 @@ class LinearContact(ContactLaw):
 
     def critical_stiffness(self, radius, mass):
         return max(self.kn, self.ks)
+
+    def critical_stiffnesses(self, radius, mass):
+        return self.kn, self.ks
 
     @staticmethod
     @ti.func

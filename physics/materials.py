@@ -203,7 +203,7 @@ class Elastic(Material):
 
     _ARGS = ("density", "young", "poisson")
 
-    def __init__(self, density=2500.0, young=30e9, poisson=0.25):
+    def __init__(self, *, density=2500.0, young=30e9, poisson=0.25):
         self._elastic(density, young, poisson)
 
     def row(self):
@@ -233,7 +233,7 @@ class MohrCoulomb(Material):
              "tensile_strength", "dilation_angle", "brittle", "residual_cohesion",
              "residual_tensile_strength")
 
-    def __init__(self, density=2500.0, young=30e9, poisson=0.25, cohesion=3e6,
+    def __init__(self, *, density=2500.0, young=30e9, poisson=0.25, cohesion=3e6,
                  friction_angle=40.0, tensile_strength=1e6, dilation_angle=0.0,
                  brittle=False, residual_cohesion=0.0, residual_tensile_strength=0.0):
         self._elastic(density, young, poisson)
@@ -352,7 +352,7 @@ class Fluid(Material):
     _ARGS = ("density", "bulk_modulus", "viscosity", "linear_viscosity",
              "quadratic_viscosity", "tensile_strength", "equation_of_state")
 
-    def __init__(self, density=1000.0, bulk_modulus=2e9, viscosity=0.0,
+    def __init__(self, *, density=1000.0, bulk_modulus=2e9, viscosity=0.0,
                  linear_viscosity=0.0, quadratic_viscosity=0.0, tensile_strength=0.0,
                  equation_of_state=False):
         self.density = positive("density", density)
@@ -412,7 +412,7 @@ class JWL(Material):
     _ARGS = ("A", "B", "R1", "R2", "omega", "E0", "density", "D", "linear_viscosity",
              "quadratic_viscosity")
 
-    def __init__(self, A, B, R1, R2, omega, E0, density, D, linear_viscosity=0.06,
+    def __init__(self, *, A, B, R1, R2, omega, E0, density, D, linear_viscosity=0.06,
                  quadratic_viscosity=1.5):
         self.A = positive("A", A)
         self.B = positive("B", B)

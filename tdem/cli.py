@@ -35,9 +35,17 @@ def main(argv=None):
     if not argv:
         p.print_help()
         return 2
-    # let "tdem run CASE --help" reach the case's own parser
-    ns = p.parse_args(argv)
     cases = _cases()
+    if argv[0] == "run" and (len(argv) == 1 or argv[1] in ("-h", "--help")):
+        print("usage: tdem run CASE [--preset quick|paper] [--arch cpu|gpu] [--out DIR] "
+              "[--threads N] [case options]\n\n'tdem run CASE --help' shows a case's "
+              "options. The cases:")
+        width = max((len(n) for n in cases), default=0)
+        for name, desc in cases.items():
+            print(f"  {name:<{width}}  {desc}")
+        return 0 if len(argv) > 1 else 2
+    # "tdem run CASE --help" reaches the case's own parser (argparse.REMAINDER)
+    ns = p.parse_args(argv)
     if ns.command == "list":
         width = max((len(n) for n in cases), default=0)
         for name, desc in cases.items():
@@ -48,8 +56,13 @@ def main(argv=None):
             print(f"tdem: unknown case {ns.case!r}; the cases are: "
                   f"{', '.join(cases) or '(none)'} (see 'tdem list')", file=sys.stderr)
             return 2
+        from cases import _common
         module = importlib.import_module(f"cases.{ns.case}")
-        result = module.main(ns.args)
+        _common.COMMAND = f"tdem run {ns.case}"
+        try:
+            result = module.main(ns.args)
+        finally:
+            _common.COMMAND = None
         return result if isinstance(result, int) else 0
     p.print_help()
     return 2

@@ -21,6 +21,7 @@ It uses the model attributes that :class:`tdem.Simulation` sets up (``_host``,
 import math
 import sys
 import time as _time
+import warnings
 
 import numpy as np
 import taichi as ti
@@ -419,6 +420,23 @@ class Runner:
                               float(self._dt_run))
         return a["flags"].to_numpy()
 
+    def _warn_dense_packing(self, dt):
+        """Warn once per time step value when it exceeds the stable step of a dense
+        packing of the particles (:meth:`tdem.Simulation.stable_dt`); not for models
+        of fewer than seven particles (no particle can have six contacts)."""
+        if self._n < 7 or getattr(self, "_dense_warned", None) == dt:
+            return
+        stable = self.stable_dt()
+        if dt > stable:
+            self._dense_warned = dt
+            crit = self.critical_dt()
+            warnings.warn(
+                f"dt = {dt:.4g} s is above {stable:.4g} s, the stable step of a dense "
+                f"(hexagonal) packing of these particles with their contact laws "
+                f"(critical_dt() = {crit:.4g} s is that of one contact): a dense packing "
+                f"will go unstable; use dt_fraction <= {stable / crit:.3g} or "
+                f"dt <= {stable:.4g}", RuntimeWarning, stacklevel=3)
+
     def _grow(self, flags):
         need, needw = int(flags[F_NEED]), int(flags[F_WALL_NEED])
         state = self._download()
@@ -452,6 +470,7 @@ class Runner:
             self._check_dt_value(self._dt_user)  # particles or laws may have changed since
         self._upload_params()
         dt = self._dt_run
+        self._warn_dense_packing(dt)
         if steps is not None:
             if int(steps) != steps or steps < 0:
                 raise InputError(f"steps must be a whole number >= 0, got {steps!r}")

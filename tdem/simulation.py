@@ -23,6 +23,7 @@ from physics import contact_law as _claw
 from physics.contact_law import ContactLaw
 from physics.linear import LinearContact
 from physics.materials import Material, MohrCoulomb
+from physics import stability as _stability
 from physics.validate import in_range, indices, non_negative
 
 from . import backend
@@ -615,18 +616,53 @@ class Simulation(Runner, Results):
             rho = np.concatenate(self._host["density"])
             m = rho * np.pi * r ** 2
             plaw = np.concatenate(self._host["law"])
+        for sel, law in self._laws_met(plaw):
+            k = law.critical_stiffness(r[sel], m[sel])
+            crit = min(crit, float(np.min(2.0 * np.sqrt(m[sel] / k))))
+        return crit
+
+    def _laws_met(self, plaw):
+        """(particles, law) for each law group present and each law its particles
+        can meet (other groups' and walls')."""
         table = self._law_table()
         wall_laws = {int(w[stepk.W_LAW]) for w in self._walls_host}
         present = np.unique(plaw)
         for law_id in present:
             sel = plaw == law_id
-            used = {int(table[law_id, other]) for other in present} | wall_laws
-            k = np.zeros(int(sel.sum()))
-            for u in used:
-                law = self._laws[u]
-                k = np.maximum(k, law.critical_stiffness(r[sel], m[sel]))
-            crit = min(crit, float(np.min(2.0 * np.sqrt(m[sel] / k))))
-        return crit
+            for u in sorted({int(table[law_id, other]) for other in present} | wall_laws):
+                yield sel, self._laws[u]
+
+    def stable_dt(self):
+        """The stable time step of a dense (hexagonal) packing of these particles: the
+        smallest over particles and the laws each can meet of 2/ω_max of the
+        hexagonal lattice of discs of its mass with the law's normal, shear and
+        rolling springs (:mod:`physics.stability`). :meth:`critical_dt` is that of
+        one contact (C&S); a particle with six contacts and shear springs as stiff as
+        the normal ones is stable only up to 0.20 of it. A run whose step exceeds
+        this one warns (a dense packing would go unstable). Plain DEM particles only
+        (PCMM particles are held by their elements, whose bound is in
+        :meth:`critical_dt`)."""
+        if self._n == 0:
+            return math.inf
+        r = self._radii()
+        if self._built:
+            m = self._a["prop"].to_numpy()[:, 1]
+            plaw = self._a["plaw"].to_numpy()
+        else:
+            m = np.concatenate(self._host["density"]) * np.pi * r ** 2
+            plaw = np.concatenate(self._host["law"])
+        dem = np.concatenate(self._host["mat"]) < 0       # PCMM particles: elements
+        out = math.inf
+        for sel, law in self._laws_met(plaw):
+            sel = sel & dem
+            if not sel.any():
+                continue
+            kn, ks = law.critical_stiffnesses(r[sel], m[sel])
+            kn = np.broadcast_to(np.asarray(kn, dtype=float), r[sel].shape)
+            ks = np.broadcast_to(np.asarray(ks, dtype=float), r[sel].shape)
+            roll = law.rolling.delta ** 2 / 12.0 if law.rolling is not None else 0.0
+            out = min(out, float(np.min(_stability.stable_dt(kn, ks, m[sel], roll))))
+        return out
 
     # ------------------------------------------------ monitors, output, checkpoints
     def monitor(self, name, fn, every=100):

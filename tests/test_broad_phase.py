@@ -13,7 +13,7 @@ def test_grid_finds_exactly_the_touching_particle_edge_pairs():
     v, t = tdem.mesh.polygon(corners, 0.05)
     be = boundary_edges(t)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt=1e-9, progress=False)
-    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e7, 0.25))
+    block = sim.add_block(v, t, material=tdem.Elastic(density=2500.0, young=1e7, poisson=0.25))
     block.fix(np.arange(len(v)), vx=0.0, vy=0.0)
     # discs scattered around the boundary (most within a radius of an edge) and far away
     k = rng.integers(0, len(be), 300)

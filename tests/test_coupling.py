@@ -21,7 +21,7 @@ def _rotated_block(angle_deg, length=2.0, thick=0.2):
 def _disc_on(angle_deg, friction_angle, damping=0.0):
     v, t, tang, nrm = _rotated_block(angle_deg)
     sim = tdem.Simulation(gravity=(0.0, -G), local_damping=damping, dt_fraction=0.5)
-    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e8, 0.25))
+    block = sim.add_block(v, t, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25))
     block.fix(np.arange(len(v)), vx=0.0, vy=0.0)
     r = 0.05
     disc = sim.add_particles([nrm * r], r, density=2000.0,
@@ -73,7 +73,7 @@ def test_disc_stays_on_a_15_degree_edge():
 def test_cohesive_contact_breaks_in_tension_at_t_times_a_then_stays_weak():
     v, t, _, _ = _rotated_block(0.0)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt=1e-5)
-    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e9, 0.25))
+    block = sim.add_block(v, t, material=tdem.Elastic(density=2500.0, young=1e9, poisson=0.25))
     block.fix(np.arange(len(v)), vx=0.0, vy=0.0)
     r, T = 0.05, 1e4
     disc = sim.add_particles([[0.0, 0.9 * r]], r, density=2000.0,
@@ -103,7 +103,7 @@ def test_cohesive_contact_breaks_in_tension_at_t_times_a_then_stays_weak():
 def test_particle_block_collision_conserves_momentum():
     v, t = tdem.mesh.rectangle(0.4, 0.2, 8, 4, pattern="cross")
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.2)
-    block = sim.add_block(v, t, material=tdem.Elastic(1000.0, 1e7, 0.3))
+    block = sim.add_block(v, t, material=tdem.Elastic(density=1000.0, young=1e7, poisson=0.3))
     r = 0.03
     discs = sim.add_particles([[0.1, 0.3], [0.3, 0.26], [-0.1, 0.1]], r, density=1500.0,
                               contact=tdem.LinearContact(kn=1e6),
@@ -155,7 +155,7 @@ def _block_on_incline(angle_deg, damping=0.0, rigid=False):
     vb, tb = tdem.mesh.rectangle(3.0, 0.2, 15, 1, origin=(-1.5, -0.2))
     vt, tt = tdem.mesh.rectangle(0.2, 0.2, 2, 2, pattern="cross", origin=(0.33, 0.0))
     sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5, local_damping=damping)
-    mat = tdem.Elastic(2500.0, 1e9, 0.25)
+    mat = tdem.Elastic(density=2500.0, young=1e9, poisson=0.25)
     base = sim.add_block(vb @ rot.T, tb, material=mat)
     base.fix(np.arange(len(vb)), vx=0.0, vy=0.0)
     top = sim.add_block(vt @ rot.T, tt, material=mat, rigid=rigid)
@@ -203,7 +203,7 @@ def test_block_block_collision_conserves_momentum(rigid):
     va, ta = tdem.mesh.rectangle(0.2, 0.2, 2, 2, pattern="cross")
     vb, tb = tdem.mesh.rectangle(0.2, 0.2, 2, 2, pattern="cross", origin=(0.201, 0.05))
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
-    mat = tdem.Elastic(1000.0, 1e7, 0.3)
+    mat = tdem.Elastic(density=1000.0, young=1e7, poisson=0.3)
     a = sim.add_block(va, ta, material=mat, velocity=(1.0, 0.1), rigid=rigid)
     b = sim.add_block(vb, tb, material=mat, velocity=(-0.5, 0.0))
     sim.couple(a, b, tdem.PointEdge(friction_angle=25.0))
@@ -224,7 +224,7 @@ def test_block_block_collision_conserves_momentum(rigid):
 def test_rigid_block_falls_freely_and_keeps_its_shape():
     v, t = tdem.mesh.rectangle(0.3, 0.1, 3, 1)
     sim = tdem.Simulation(gravity=(0.0, -G), dt=1e-4)
-    b = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e9, 0.25), rigid=True,
+    b = sim.add_block(v, t, material=tdem.Elastic(density=2500.0, young=1e9, poisson=0.25), rigid=True,
                       velocity=(1.0, 0.0))
     sim.run(steps=1000)
     nd = b.nodes()
@@ -253,7 +253,7 @@ def test_point_edge_contacts_are_written_for_paraview(tmp_path):
 def test_cohesive_contact_sheared_caps_then_loses_its_cohesion():
     v, t, _, _ = _rotated_block(0.0)
     sim = tdem.Simulation(gravity=(0.0, -G), dt=2e-5)
-    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e8, 0.25))
+    block = sim.add_block(v, t, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25))
     block.fix(np.arange(len(v)), vx=0.0, vy=0.0)
     r, C, phi = 0.05, 2e3, 30.0
     disc = sim.add_particles([[0.03, r]], r, density=2000.0, contact=tdem.LinearContact(kn=1e7))
@@ -290,7 +290,7 @@ def _plate_hits_disc(dy, speed=0.5, r=0.025, duration=0.12):
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5, local_damping=0.0,
                           progress=False)
     # the plate is kinematic: a soft material keeps the time step of the disc
-    plate = sim.add_block(v, t, material=tdem.Elastic(7800.0, 1e7, 0.3))
+    plate = sim.add_block(v, t, material=tdem.Elastic(density=7800.0, young=1e7, poisson=0.3))
     plate.fix(np.arange(len(v)), vx=speed, vy=0.0)
     disc = sim.add_particles([[r + 0.01, dy]], r, density=1750.0,
                              contact=tdem.LinearContact(kn=1e7))
@@ -333,7 +333,7 @@ def test_stacked_rigid_blocks_pushed_sideways_stay_on_each_other():
     # kinetic energy stays below ½·m·V² plus the work of gravity over the settlement.
     V, kn, a = 0.05, 3e8, 0.1
     sim = tdem.Simulation(gravity=(0.0, -G), dt=9.4e-5, local_damping=0.0, progress=False)
-    concrete = tdem.Elastic(2400.0, 30e9, 0.2)
+    concrete = tdem.Elastic(density=2400.0, young=30e9, poisson=0.2)
     fv, ft = tdem.mesh.rectangle(1.0, 0.1, 1, 1, origin=(-0.5, -0.1))
     floor = sim.add_block(fv, ft, material=concrete, rigid=True)
     floor.fix(np.arange(len(fv)), vx=0.0, vy=0.0)

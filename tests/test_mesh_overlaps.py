@@ -7,7 +7,7 @@ import pytest
 import tdem
 from tdem import mesh
 
-MAT = tdem.Elastic(2000.0, 1e7, 0.25)
+MAT = tdem.Elastic(density=2000.0, young=1e7, poisson=0.25)
 
 
 def _add(v, t):

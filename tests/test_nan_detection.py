@@ -50,7 +50,7 @@ def test_nan_in_the_state_stops_the_run():
 def test_nan_node_velocity_of_a_block_stops_the_run():
     v, t = tdem.mesh.rectangle(0.4, 0.2, 2, 1)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt=1e-5, progress=False)
-    block = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e7, 0.25))
+    block = sim.add_block(v, t, material=tdem.Elastic(density=2500.0, young=1e7, poisson=0.25))
     block.fix([2], vx=lambda t: math.nan if t > 5e-5 else 0.0)
     with pytest.raises(tdem.InstabilityError, match="node 2 of block 0") as e:
         sim.run(steps=100)

@@ -13,7 +13,7 @@ def _bar(end, kind="block"):
     """A plane P-wave (lateral motion blocked) sent down a 20 m bar by a half-sine
     velocity pulse; the far end is fixed or non-reflecting. Returns the velocity
     history at x = 10 m."""
-    mat = tdem.Elastic(RHO, E, NU)
+    mat = tdem.Elastic(density=RHO, young=E, poisson=NU)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
     T, amp = 2e-3, 1.0
 

@@ -31,7 +31,7 @@ def _stretched(kind, lxx, lyy, steps):
     pos, rad, tol = packing(kind)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
     v0 = pos * np.array([lxx, lyy])
-    g = sim.add_particles(pos, rad, material=tdem.Elastic(RHO, E, NU), tolerance=tol,
+    g = sim.add_particles(pos, rad, material=tdem.Elastic(density=RHO, young=E, poisson=NU), tolerance=tol,
                           velocity=v0)
     sim.fix_particles(g.ids, vx=v0[:, 0], vy=v0[:, 1])
     sim.run(steps=steps)
@@ -80,7 +80,7 @@ def test_patch_mohr_coulomb_state_reaches_the_particles(mode):
     cut-off with no plastic shear strain, and is still marked failed."""
     from test_materials import correct
     lxx, lyy, coh, ten = (2.0, -2.0, 1e6, 2e7) if mode == "shear" else (2.0, 2.0, 1e8, 1e6)
-    mat = tdem.MohrCoulomb(RHO, E, NU, cohesion=coh, friction_angle=30.0,
+    mat = tdem.MohrCoulomb(density=RHO, young=E, poisson=NU, cohesion=coh, friction_angle=30.0,
                            tensile_strength=ten)
     pos, rad, tol = packing("regular")
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
@@ -130,7 +130,7 @@ def test_rigid_rotation_90_degrees(kind):
     pos, rad, tol = packing(kind)
     c = pos.mean(axis=0)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
-    g = sim.add_particles(pos, rad, material=tdem.Elastic(RHO, E, NU), tolerance=tol)
+    g = sim.add_particles(pos, rad, material=tdem.Elastic(density=RHO, young=E, poisson=NU), tolerance=tol)
     dt = sim.dt
     nturn = 300
     w = 0.5 * np.pi / (nturn * dt)
@@ -154,7 +154,7 @@ def test_prestressed_rotation_swaps_stresses():
     pos, rad, tol = packing("regular")
     c = pos.mean(axis=0)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
-    g = sim.add_particles(pos, rad, material=tdem.Elastic(RHO, E, NU), tolerance=tol)
+    g = sim.add_particles(pos, rad, material=tdem.Elastic(density=RHO, young=E, poisson=NU), tolerance=tol)
     dt = sim.dt
     nstretch, nturn = 10, 300
     w = 0.5 * np.pi / (nturn * dt)
@@ -288,7 +288,7 @@ def test_block_patch_and_gravity_reaction():
     weight (to round-off) once static; a uniform stretch gives Hooke's stress."""
     v, t = tdem.mesh.rectangle(2.0, 1.0, 8, 4, pattern="cross")
     sim = tdem.Simulation(gravity=(0.0, -9.81), local_damping=0.8, dt_fraction=0.5)
-    mat = tdem.Elastic(RHO, E, NU)
+    mat = tdem.Elastic(density=RHO, young=E, poisson=NU)
     b = sim.add_block(v, t, material=mat)
     b.fix(b.nodes_in(ymax=1e-9), vx=0.0, vy=0.0)
     sim.run(steps=3000)
@@ -340,7 +340,7 @@ def test_checkpoint_of_pcmm_and_block_restarts_exactly(tmp_path):
         pos, rad = tdem.pack.regular(0.4, 0.3, 0.01, origin=(0.0, 0.0))
         sim.add_particles(pos, rad, material=soil, tolerance=0.01)
         v, t = tdem.mesh.rectangle(0.4, 0.05, 8, 1, origin=(0.0, -0.05))
-        b = sim.add_block(v, t, material=tdem.Elastic(2500.0, 1e8, 0.25))
+        b = sim.add_block(v, t, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25))
         b.fix(b.nodes_in(ymax=-0.05 + 1e-9), vx=0.0, vy=0.0)
         sim.fix_particles(sim.particles_in(ymax=0.011), vx=0.0, vy=0.0)
         return sim, b
@@ -392,7 +392,7 @@ def test_contact_law_takes_over_from_a_dying_element_without_a_jump():
     r, kn = 0.01, 1e6
     pos = np.array([[0.0, 0.0], [0.018, 0.0], [0.009, 0.0156]])
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.3, progress=False)
-    sim.add_particles(pos, np.full(3, r), material=tdem.Elastic(1000.0, 1e6, 0.25),
+    sim.add_particles(pos, np.full(3, r), material=tdem.Elastic(density=1000.0, young=1e6, poisson=0.25),
                       tolerance=0.001, contact=tdem.LinearContact(kn=kn, ks=kn, friction=0.0))
     sim.fix_particles([0, 1], vx=0.0, vy=0.0)
     sim.fix_particles([2], vx=0.0, vy=5.0)

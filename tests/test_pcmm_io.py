@@ -38,7 +38,7 @@ def test_pcmm_elements_and_particles_read_back(tmp_path):
     stress, plastic shear strain, failure mark and displacement are those of the
     simulation, and the displacement is the prescribed motion."""
     lxx, lyy, steps = 2.0, -2.0, 40
-    mat = tdem.MohrCoulomb(RHO, E, NU, cohesion=1e6, friction_angle=30.0,
+    mat = tdem.MohrCoulomb(density=RHO, young=E, poisson=NU, cohesion=1e6, friction_angle=30.0,
                            tensile_strength=2e7)
     pos, rad = tdem.pack.regular(1.0, 0.6, 0.05)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
@@ -97,7 +97,7 @@ def test_block_read_back(tmp_path):
     of the stretch (1e-6), its node displacement and reaction those of the block."""
     v, t = tdem.mesh.rectangle(2.0, 1.0, 8, 4, pattern="cross")
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.5)
-    b = sim.add_block(v, t, material=tdem.Elastic(RHO, E, NU), velocity=(0.0, 0.0))
+    b = sim.add_block(v, t, material=tdem.Elastic(density=RHO, young=E, poisson=NU), velocity=(0.0, 0.0))
     lxx, lyy = 1.0, 0.3
     b.fix(np.arange(len(v)), vx=v[:, 0] * lxx, vy=v[:, 1] * lyy)
     sim.run(steps=1)                      # first step: nodes at rest, then moving

@@ -26,7 +26,7 @@ def _everything():
     hertz = tdem.HertzMindlin(young=1e8, poisson=0.3, friction=0.4)
     # a PCMM elastic body on a floor, discs of two laws dropped onto it
     body = sim.add_particles(_square(10, 3, R, (0.01, 0.0105)), R,
-                             material=tdem.Elastic(2500.0, 5e6, 0.25), tolerance=0.5 * R)
+                             material=tdem.Elastic(density=2500.0, young=5e6, poisson=0.25), tolerance=0.5 * R)
     sim.add_particles(_square(4, 1, R, (0.03, 0.08)), R, density=2500.0, contact=lin,
                       velocity=(0.0, -0.5))
     hz = sim.add_particles(_square(3, 1, R, (0.12, 0.08)), R, density=2500.0, contact=hertz,
@@ -41,10 +41,10 @@ def _everything():
     sim.detonate(tnt, (1.0, 1.0))
     # a fixed deformable base block, a rigid block on it, a disc on the base
     vb, tb = tdem.mesh.rectangle(0.4, 0.05, 8, 1, origin=(0.5, -0.05))
-    base = sim.add_block(vb, tb, material=tdem.Elastic(2500.0, 1e8, 0.25))
+    base = sim.add_block(vb, tb, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25))
     base.fix(np.arange(len(vb)), vx=0.0, vy=0.0)
     vt, tt = tdem.mesh.rectangle(0.05, 0.05, 1, 1, origin=(0.55, -0.0001))
-    top = sim.add_block(vt, tt, material=tdem.Elastic(2500.0, 1e8, 0.25), rigid=True,
+    top = sim.add_block(vt, tt, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25), rigid=True,
                         velocity=(0.2, 0.0))
     sim.couple(top, base, tdem.PointEdge(friction_angle=25.0))
     disc = sim.add_particles([[0.75, 0.0099]], R, density=2500.0, contact=lin,
