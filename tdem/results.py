@@ -131,6 +131,13 @@ class Results:
                     "stress_zz": np.zeros(0)}
         return self._cont.elements()
 
+    def measure(self, box=None, circle=None, polygon=None):
+        """Love–Weber stress (tension-positive), porosity, coordination and fabric of the
+        particles whose centres lie in a box ``((x0, y0), (x1, y1))``, a circle
+        ``((cx, cy), r)`` or a polygon ``(K, 2)`` (:mod:`tdem.measure`)."""
+        from .measure import measure
+        return measure(self, box=box, circle=circle, polygon=polygon)
+
     def point_edge_contacts(self):
         """Point–edge contacts in force now (particle–block and block–block), a dict of
         numpy arrays: point (C, 2) (particle centre or block vertex), foot (C, 2)

@@ -1,0 +1,113 @@
+"""Measurements over a region, as PFC's measurement circles and Yade's averages:
+the Love–Weber stress, porosity, coordination number and fabric tensor of the
+particles whose centres lie in a box, a circle or a polygon.
+
+For the particles p in the region (area A):
+
+- stress σ = (1/A) Σ_p Σ_c sym((x_c − x_p) ⊗ f_c), f_c the force of contact c on p
+  at its contact point x_c (particle and wall contacts), tension-positive (Love 1927,
+  Weber 1966). Over a region that holds a whole specimen in equilibrium it is the
+  stress its boundary carries; the pairs inside a region count once from each side;
+- porosity 1 − Σ_p π R_p² / A (a particle counts whole where its centre lies);
+- coordination: the mean number of contacts (with particles and walls) of the
+  particles in the region;
+- fabric φ = (1/N_c) Σ_c n_c ⊗ n_c over the contacts of those particles (trace 1).
+
+Contacts carried by PCMM elements are not contacts here (their stress is the
+particles' ``stress``).
+"""
+import math
+
+import numpy as np
+
+from .errors import InputError
+
+
+class Region:
+    """A box ((x0, y0), (x1, y1)), a circle ((cx, cy), r) or a polygon (K, 2)."""
+
+    def __init__(self, box=None, circle=None, polygon=None):
+        given = [k for k, v in (("box", box), ("circle", circle), ("polygon", polygon))
+                 if v is not None]
+        if len(given) != 1:
+            raise InputError(f"measure takes exactly one of box=, circle=, polygon=, got "
+                             f"{given or 'none'}")
+        self.kind = given[0]
+        try:
+            if box is not None:
+                lo, hi = np.asarray(box, dtype=float).reshape(2, 2)
+                if not (np.all(np.isfinite([lo, hi])) and np.all(hi > lo)):
+                    raise ValueError
+                self.lo, self.hi = lo, hi
+                self.area = float(np.prod(hi - lo))
+            elif circle is not None:
+                c, r = circle
+                self.c = np.asarray(c, dtype=float).reshape(2)
+                self.r = float(r)
+                if not (np.all(np.isfinite(self.c)) and math.isfinite(self.r)
+                        and self.r > 0):
+                    raise ValueError
+                self.area = math.pi * self.r ** 2
+            else:
+                p = np.asarray(polygon, dtype=float)
+                if p.ndim != 2 or p.shape[1] != 2 or len(p) < 3 or not np.isfinite(p).all():
+                    raise ValueError
+                x, y = p[:, 0], p[:, 1]
+                self.area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+                if self.area <= 0:
+                    raise ValueError
+                from matplotlib.path import Path
+                self.path = Path(p)
+        except (TypeError, ValueError):
+            value = {"box": box, "circle": circle, "polygon": polygon}[self.kind]
+            raise InputError(f"{self.kind} must be "
+                             + {"box": "((x0, y0), (x1, y1)) with x1 > x0 and y1 > y0",
+                                "circle": "((cx, cy), r) with r > 0",
+                                "polygon": "(K, 2) vertices, K >= 3, of non-zero area"}
+                             [self.kind] + f", got {value!r}") from None
+
+    def contains(self, x):
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        if self.kind == "box":
+            return np.all((x >= self.lo) & (x <= self.hi), axis=1)
+        if self.kind == "circle":
+            return np.sum((x - self.c) ** 2, axis=1) <= self.r ** 2
+        return self.path.contains_points(x)
+
+
+def measure(sim, box=None, circle=None, polygon=None):
+    """The measurements of the module docstring for ``sim`` now: a dict with stress
+    (2, 2) Pa (N/m² per metre of thickness in 2D), porosity, coordination, fabric
+    (2, 2), particles (how many), contacts (how many counted), area (m²)."""
+    region = Region(box, circle, polygon)
+    p = sim.particles.numpy() if sim.n_particles else None
+    if p is None:
+        raise InputError("measure needs particles: add some first")
+    inside = region.contains(p["position"])
+    c = sim.contacts.numpy()
+    i, j = c["pairs"][:, 0], c["pairs"][:, 1]
+    n = c["direction"]
+    t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+    f = -c["normal"][:, None] * n + c["shear"][:, None] * t      # on the first particle
+    # each contact seen from each of its particles in the region: (owner, force, normal)
+    sides = []
+    own = inside[i]
+    sides.append((i[own], f[own], c["point"][own]))
+    part = (j >= 0)
+    other = np.zeros(len(j), bool)
+    other[part] = inside[j[part]]
+    sides.append((j[other], -f[other], c["point"][other]))
+    owner = np.concatenate([s[0] for s in sides])
+    force = np.concatenate([s[1] for s in sides])
+    point = np.concatenate([s[2] for s in sides])
+    normal = np.concatenate([n[own], n[other]])
+    arm = point - p["position"][owner]
+    s = np.einsum("ca,cb->ab", arm, force)
+    stress = 0.5 * (s + s.T) / region.area
+    npart = int(inside.sum())
+    ncont = len(owner)
+    fabric = (np.einsum("ca,cb->ab", normal, normal) / ncont) if ncont else np.zeros((2, 2))
+    solid = float(np.sum(math.pi * p["radius"][inside] ** 2))
+    return {"stress": stress, "porosity": 1.0 - solid / region.area,
+            "coordination": ncont / npart if npart else 0.0, "fabric": fabric,
+            "particles": npart, "contacts": ncont, "area": region.area}
