@@ -220,7 +220,8 @@ class MohrCoulomb(Material):
     cohesion : c (Pa), ≥ 0
     friction_angle : φ in degrees, in [0, 90)
     tensile_strength : T (Pa), ≥ 0; capped at c/tan φ when φ > 0 (the value in use
-        is ``tension``)
+        is ``tension``). Default None: the Mohr–Coulomb apex c/tan φ (the largest
+        tension the envelope allows), and 0 when φ = 0 (as FLAC)
     dilation_angle : ψ in degrees, in [0, φ] (0: no plastic volume change)
     brittle : after a particle's first failure its c and T drop to the residual values
     residual_cohesion, residual_tensile_strength : c_r, T_r (Pa), ≥ 0, default 0;
@@ -234,12 +235,15 @@ class MohrCoulomb(Material):
              "residual_tensile_strength")
 
     def __init__(self, *, density=2500.0, young=30e9, poisson=0.25, cohesion=3e6,
-                 friction_angle=40.0, tensile_strength=1e6, dilation_angle=0.0,
+                 friction_angle=40.0, tensile_strength=None, dilation_angle=0.0,
                  brittle=False, residual_cohesion=0.0, residual_tensile_strength=0.0):
         self._elastic(density, young, poisson)
         self.cohesion = non_negative("cohesion", cohesion)
         self.friction_angle = in_range("friction_angle", friction_angle, 0.0, 90.0,
                                        hi_open=True)
+        if tensile_strength is None:
+            tensile_strength = (_tension_cap(self.cohesion, self.friction_angle)
+                                if self.friction_angle > 0.0 else 0.0)
         self.tensile_strength = non_negative("tensile_strength", tensile_strength)
         self.dilation_angle = in_range("dilation_angle", dilation_angle, 0.0,
                                        self.friction_angle)

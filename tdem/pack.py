@@ -595,3 +595,44 @@ def _edge_discs(poly, rmin, rmax, rng):
             rs.append(ri)
             inside += 0.5 * math.pi * float(np.sum(ri * ri))
     return np.concatenate(xs), np.concatenate(rs), inside
+
+
+def largest_overlap(positions, radii, among=None):
+    """The largest overlap of two discs relative to the smaller radius, and the pair:
+    (u / min(R_i, R_j), i, j), (0.0, -1, -1) when none touch; ``among`` (a boolean
+    mask): only pairs with at least one disc in it. A cell grid of the largest
+    diameter finds the candidate pairs (numpy, O(N log N))."""
+    x = np.asarray(positions, dtype=float).reshape(-1, 2)
+    r = np.asarray(radii, dtype=float).reshape(-1)
+    n = len(x)
+    if n < 2:
+        return 0.0, -1, -1
+    h = 2.0 * float(r.max())
+    c = np.floor((x - x.min(axis=0)) / h).astype(np.int64)
+    ny = int(c[:, 1].max()) + 3
+    key = c[:, 0] * ny + c[:, 1]
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    best, bi, bj = 0.0, -1, -1
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            target = key + dx * ny + dy
+            lo = np.searchsorted(skey, target, "left")
+            hi = np.searchsorted(skey, target, "right")
+            cnt = hi - lo
+            total = int(cnt.sum())
+            if total == 0:
+                continue
+            i = np.repeat(np.arange(n), cnt)
+            j = order[np.repeat(lo, cnt) + np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt)]
+            keep = i < j
+            if among is not None:
+                keep &= among[i] | among[j]
+            i, j = i[keep], j[keep]
+            u = r[i] + r[j] - np.linalg.norm(x[j] - x[i], axis=1)
+            rel = u / np.minimum(r[i], r[j])
+            if rel.size:
+                k = int(np.argmax(rel))
+                if rel[k] > best:
+                    best, bi, bj = float(rel[k]), int(i[k]), int(j[k])
+    return best, bi, bj

@@ -15,6 +15,7 @@ unstable particles), keeps a device-side snapshot of the state, records monitors
 writes output.
 """
 import math
+import warnings
 
 import numpy as np
 import taichi as ti
@@ -28,6 +29,7 @@ from physics.validate import in_range, indices, non_negative
 
 from . import backend
 from . import mesh as _mesh
+from . import pack as _pack
 from . import step as stepk
 from .errors import InputError
 from .handles import (Block, ParticleGroup, Wall, _View, _as_xy, _fix_value, _in_box,
@@ -51,6 +53,26 @@ def _per_particle(name, value, n):
         raise InputError(f"{name} must be a number or one per particle ({n}), got "
                          f"shape {a.shape}")
     return np.broadcast_to(a, (n,)).copy()
+
+
+OVERLAP_WARN = 0.1    # initial overlap, relative to the smaller radius, that warns
+
+
+def _warn_overlaps(old, old_r, new, new_r):
+    """Warn when new discs start overlapping (each other or the plain discs already
+    there; ``old_r`` is NaN for PCMM particles) by more than OVERLAP_WARN of the
+    smaller radius: the springs then push them apart at speed in the first steps."""
+    keep = ~np.isnan(old_r)
+    ids = np.concatenate([np.flatnonzero(keep), len(old) + np.arange(len(new))])
+    fresh = np.concatenate([np.zeros(int(keep.sum()), bool), np.ones(len(new), bool)])
+    rel, i, j = _pack.largest_overlap(np.concatenate([old[keep], new]),
+                                      np.concatenate([old_r[keep], new_r]), among=fresh)
+    if rel > OVERLAP_WARN:
+        warnings.warn(f"positions: particles {int(ids[i])} and {int(ids[j])} start "
+                      f"overlapping by {rel:.0%} of the smaller radius (the largest initial "
+                      f"overlap): their contact springs will push them apart at speed in "
+                      f"the first steps; move them apart or let the packing relax first",
+                      RuntimeWarning, stacklevel=3)
 
 
 def _refuse_coincident(old, new):
@@ -219,6 +241,8 @@ class Simulation(Runner, Results):
         old = state["pos"] if state is not None else (
             np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, 2)))
         _refuse_coincident(old, pos)
+        if material is None:
+            _warn_overlaps(old, self._dem_radii(state), pos, r)
         # every check passed: from here on the model changes (the law is checked
         # before it is added)
         law = self._law_id(contact)
@@ -237,6 +261,16 @@ class Simulation(Runner, Results):
         if state is not None:
             self._rebuild_from(state, new_particles=(pos, vel, r, rho, law))
         return g
+
+    def _dem_radii(self, state):
+        """Radii of the particles there now, NaN for PCMM ones (their overlaps are
+        meant: elements hold them)."""
+        if not self._n:
+            return np.zeros(0)
+        r = state["prop"][:, 0].copy() if state is not None else np.concatenate(
+            self._host["radius"])
+        r[np.concatenate(self._host["mat"]) >= 0] = np.nan
+        return r
 
     def _slot_of(self, material, tol):
         for k, (m, t) in enumerate(self._slots):

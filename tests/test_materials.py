@@ -127,7 +127,7 @@ BAD = [
     (MohrCoulomb, "friction_angle", -5), (MohrCoulomb, "tensile_strength", -1e6),
     (MohrCoulomb, "dilation_angle", -1), (MohrCoulomb, "dilation_angle", 45),
     (MohrCoulomb, "brittle", "yes"), (MohrCoulomb, "residual_cohesion", -1),
-    (MohrCoulomb, "residual_cohesion", 4e6), (MohrCoulomb, "residual_tensile_strength", 2e6),
+    (MohrCoulomb, "residual_cohesion", 4e6), (MohrCoulomb, "residual_tensile_strength", 4e6),
     (MohrCoulomb, "poisson", 0.5), (MohrCoulomb, "density", 0),
     (Fluid, "density", -1000), (Fluid, "bulk_modulus", 0), (Fluid, "viscosity", -1e-3),
 ]
