@@ -2,11 +2,13 @@
 a particle tests are those of its grid cell; the contacts found must be exactly the
 pairs that the contact rule gives when every edge is tested."""
 import numpy as np
+import pytest
 
 import tdem
 from tdem.mesh import boundary_edges
 
 
+@pytest.mark.filterwarnings("ignore:positions.*overlapping:RuntimeWarning")  # random discs
 def test_grid_finds_exactly_the_touching_particle_edge_pairs():
     rng = np.random.default_rng(3)
     corners = [[0.0, 0.0], [1.2, 0.0], [1.4, 0.5], [0.6, 0.8], [-0.2, 0.4]]

@@ -13,7 +13,7 @@ def _pile(far=None):
     sim = tdem.Simulation(gravity=(0.0, -9.81), dt=1e-4)
     rng = np.random.default_rng(7)
     xs = (np.arange(20) + 0.5) * 0.02
-    pos = np.array([(x, y) for y in xs for x in xs]) + rng.uniform(-2e-3, 2e-3, (400, 2))
+    pos = np.array([(x, y) for y in xs for x in xs]) + rng.uniform(-5e-4, 5e-4, (400, 2))
     pos[:, 1] += 0.011
     sim.add_particles(pos, 0.009, density=2500.0, contact=LAW)
     if far is not None:
