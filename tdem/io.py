@@ -78,10 +78,49 @@ def _xyz(a):
     return np.concatenate([a, np.zeros((len(a), 1))], axis=1)
 
 
+# components of a 3×3 row-major tensor that get their own named array
+_TENSOR_PARTS = (("xx", 0), ("yy", 4), ("zz", 8), ("xy", 1))
+
+
+def _with_parts(data, cell):
+    """The data dict with, beside every 3×3 tensor (9 components), its components as
+    named scalars (``stress_xx``, ``stress_yy``, ``stress_zz``, ``stress_xy``), which
+    ParaView lists by name for colouring."""
+    out = dict(data)
+    for name, v in data.items():
+        blocks = v if cell else [v]
+        if all(np.ndim(b) == 2 and np.shape(b)[1] == 9 for b in blocks):
+            for part, k in _TENSOR_PARTS:
+                comp = [np.ascontiguousarray(np.asarray(b)[:, k]) for b in blocks]
+                out[f"{name}_{part}"] = comp if cell else comp[0]
+    return out
+
+
 def _write_mesh(path, points, cells, point_data=None, cell_data=None):
     import meshio
-    mesh = meshio.Mesh(points, cells, point_data=point_data or {}, cell_data=cell_data or {})
+    point_data, cell_data = point_data or {}, cell_data or {}
+    if sum(len(c[1]) for c in cells) == 0:
+        points, cells, point_data, cell_data = _placeholder(cells, point_data, cell_data)
+    mesh = meshio.Mesh(points, cells, point_data=_with_parts(point_data, False),
+                       cell_data=_with_parts(cell_data, True))
     mesh.write(str(path), file_format="vtu")
+
+
+def _placeholder(cells, point_data, cell_data):
+    """A file of nothing (no contacts yet, no walls) as one degenerate cell at the
+    origin whose data are 0 (−1 for integers): meshio, and so many readers, cannot read
+    a VTU file without cells. Its ``pair`` of a contact file is (−1, −1)."""
+    kind = cells[0][0] if cells else "vertex"
+    width = {"vertex": 1, "line": 2, "triangle": 3}.get(kind, 1)
+
+    def one(v, rows):
+        v = np.asarray(v)
+        fill = -1 if np.issubdtype(v.dtype, np.integer) else 0
+        return np.full((rows,) + v.shape[1:], fill, dtype=v.dtype)
+
+    return (np.zeros((1, 3)), [(kind, np.zeros((1, width), dtype=np.int64))],
+            {k: one(v, 1) for k, v in point_data.items()},
+            {k: [one(v[0], 1)] for k, v in cell_data.items()})
 
 
 def write_particles_vtu(sim, path, particles=None):
@@ -263,7 +302,10 @@ def write_vtu(sim, path, walls=True, contacts=True):
     """Write one snapshot of ``sim``: particles to ``path``, and beside it the walls
     to ``<stem>_walls.vtu`` and the contacts to ``<stem>_contacts.vtu`` (see
     :func:`write_particles_vtu`, :func:`write_walls_vtu`, :func:`write_contacts_vtu`
-    for the fields). Files of zero walls or zero contacts are written empty.
+    for the fields). Files of zero walls or zero contacts hold one degenerate cell at
+    the origin with zero data (pair (−1, −1)): meshio cannot read a VTU file without
+    cells. Every 3×3 tensor field also comes as named components (``stress_xx``,
+    ``stress_yy``, ``stress_zz``, ``stress_xy``).
 
     Returns the list of paths written (strings), particles first.
     """
