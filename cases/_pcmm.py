@@ -52,7 +52,7 @@ class Model:
         self.material = material
         self.origin = np.asarray(origin, dtype=float)
         t0 = time.perf_counter()
-        self.sim = tdem.Simulation(progress=False, **sim_kwargs)
+        self.sim = tdem.Simulation(**sim_kwargs)
         kind = spec["kind"]
         self.is_fvm = kind == "fvm"
         if self.is_fvm:

@@ -412,7 +412,7 @@ def prepare(n=PAPER["n"], void_ratio=PAPER["void_ratio"], confining=200e3,
     law = LinearContact(kn=kn, ks=ks, friction=prep_friction)
     wall_law = LinearContact(kn=kn, ks=ks, friction=0.0)
     sim = Simulation(gravity=(0.0, 0.0), local_damping=local_damping, dt_fraction=dt_fraction,
-                     arch=arch, threads=threads, check_interval=check_interval, progress=False)
+                     arch=arch, threads=threads, check_interval=check_interval)
     sim.add_particles(xy, r, density=density, contact=law)
     ox, oy = _WALL_OVERHANG * w, _WALL_OVERHANG * h
     walls = {

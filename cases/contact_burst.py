@@ -103,7 +103,7 @@ def charge_positions(r_e, radius_rock):
 
 def build(cfg, arch=None, threads=None):
     R, r_e = cfg["radius"], cfg["charge_particle"]
-    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=DT_FRACTION, progress=False,
+    sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=DT_FRACTION,
                           arch=arch, threads=threads)
     pos, rad = tdem.pack.regular(W, H, R, inset=0)
     rock = sim.add_particles(pos, rad, material=tdem.MohrCoulomb(**ROCK), tolerance=R)

@@ -151,7 +151,7 @@ def build(kn=KN, ratio=1.0, friction=FRICTION_ROUGH, damped=False,
     alpha, beta = damping_parameters(kn) if damped else (0.0, 0.0)
     law = tdem.LinearContact(kn=kn, ks=ratio * kn, friction=friction, damping_ratio=beta)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=dt_fraction,
-                          global_damping=alpha, progress=False, **options)
+                          global_damping=alpha, **options)
     xs = np.array([-2.0 * R, 0.0, 2.0 * R])
     pos = np.array([(x, y) for y in xs for x in xs])
     sim.add_particles(pos, R, density=DENSITY, contact=law)

@@ -205,7 +205,7 @@ def make_packing(r, cfg, **options):
     pos = random_placement(r)
     law = tdem.LinearContact(kn=KN, ks=KS, friction=0.0, restitution=PACK_RESTITUTION)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=DT_FRACTION,
-                          global_damping=PACK_ALPHA, progress=False, **options)
+                          global_damping=PACK_ALPHA, **options)
     sim.add_particles(pos, r, density=DENSITY, contact=law)
     walls = box_walls(sim, (0.0, 0.0), (BOX0, BOX0), law)
     # fast while far from jamming
@@ -236,7 +236,7 @@ def build_test(r, pos, lines, **options):
     disc = tdem.LinearContact(kn=KN, ks=KS, friction=MU_DISC, damping_ratio=BETA)
     wall = tdem.LinearContact(kn=KN, ks=KS, friction=MU_WALL, damping_ratio=BETA)
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=DT_FRACTION, global_damping=ALPHA,
-                          progress=False, **options)
+                          **options)
     sim.add_particles(pos, r, density=DENSITY, contact=disc)
     walls = box_walls(sim, (lines["left"], lines["bottom"]), (lines["right"], lines["top"]),
                       wall)

@@ -141,7 +141,7 @@ def build(cfg, arch=None, threads=None):
     R = cfg["radius"]
     soil = tdem.MohrCoulomb(**SOIL)
     sim = tdem.Simulation(gravity=(0.0, -9.81), dt_fraction=0.5, local_damping=0.7,
-                          progress=False, arch=arch, threads=threads)
+                          arch=arch, threads=threads)
     pos, radii = tdem.pack.regular(W, H, R, inset=0)
     g = sim.add_particles(pos, radii, material=soil, tolerance=R)
     fixed = np.union1d(sim.particles_in(ymax=0.5 * R), sim.particles_in(xmin=W - 0.5 * R))

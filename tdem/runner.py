@@ -37,6 +37,7 @@ from .neighbors import F_BAD, F_NEED, F_REBUILD, F_WALL_NEED, FLAGS_SIZE
 
 
 MAX_SLOTS = 1024
+_COMPILED = False          # a run with a progress bar has happened in this process
 
 
 class Runner:
@@ -604,10 +605,19 @@ class Runner:
         return self._n + (self._cont.nv if self._cont is not None else 0)
 
     def _progress_bar(self, total):
+        """A bar (steps, simulated time, rate, ETA) for a run of ``total`` steps: with
+        ``progress=True``, or on a terminal for runs of more than 2e7 particle-steps
+        (a few seconds). The first run of a process says first that it compiles."""
+        global _COMPILED
         show = self.progress
         if show is None:
             show = sys.stderr.isatty() and self._dofs() * total > 2e7
         if not show or total <= 0:
             return None
+        if not _COMPILED:
+            print("tdem: compiling kernels (the first run of a process; later runs reuse "
+                  "them)", file=sys.stderr, flush=True)
+        _COMPILED = True
         from tqdm.auto import tqdm
-        return tqdm(total=total, unit="step", desc="tdem", leave=False)
+        return tqdm(total=total, unit="step", desc=f"tdem (dt {self._dt_run:.3g} s)",
+                    leave=False)
