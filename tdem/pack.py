@@ -197,23 +197,25 @@ def _signed_distance(x, poly):
 
 
 def _pairs(x, cut, h):
-    """All pairs (i < j) closer than ``cut`` (a scalar), by a cell grid of side h >= cut."""
+    """All pairs (i < j) closer than ``cut`` (a scalar), by a cell grid of side h >= cut.
+    The occupied cells are found in the sorted cell keys, so memory is O(N) however
+    far apart the points lie."""
     lo = x.min(axis=0)
     c = np.floor((x - lo) / h).astype(np.int64)
     nx, ny = c.max(axis=0) + 1
     cell = c[:, 0] * ny + c[:, 1]
     order = np.argsort(cell, kind="stable")
-    counts = np.bincount(cell, minlength=nx * ny)
-    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    skey = cell[order]
     idx_i, idx_j = [], []
     for ox, oy in ((0, 0), (1, -1), (1, 0), (1, 1), (0, 1)):
         cx, cy = c[:, 0] + ox, c[:, 1] + oy
         ok = (cx < nx) & (cy >= 0) & (cy < ny)
         i = np.nonzero(ok)[0]
         oc = cx[ok] * ny + cy[ok]
-        m = counts[oc]
+        start = np.searchsorted(skey, oc, "left")
+        m = np.searchsorted(skey, oc, "right") - start
         rep_i = np.repeat(i, m)
-        first = np.repeat(start[oc], m)
+        first = np.repeat(start, m)
         within = np.arange(len(rep_i)) - np.repeat(np.cumsum(m) - m, m)
         j = order[first + within]
         keep = j > rep_i if (ox, oy) == (0, 0) else np.ones(len(j), bool)
@@ -600,39 +602,18 @@ def _edge_discs(poly, rmin, rmax, rng):
 def largest_overlap(positions, radii, among=None):
     """The largest overlap of two discs relative to the smaller radius, and the pair:
     (u / min(R_i, R_j), i, j), (0.0, -1, -1) when none touch; ``among`` (a boolean
-    mask): only pairs with at least one disc in it. A cell grid of the largest
-    diameter finds the candidate pairs (numpy, O(N log N))."""
+    mask): only pairs with at least one disc in it."""
     x = np.asarray(positions, dtype=float).reshape(-1, 2)
     r = np.asarray(radii, dtype=float).reshape(-1)
-    n = len(x)
-    if n < 2:
+    if len(x) < 2:
         return 0.0, -1, -1
     h = 2.0 * float(r.max())
-    c = np.floor((x - x.min(axis=0)) / h).astype(np.int64)
-    ny = int(c[:, 1].max()) + 3
-    key = c[:, 0] * ny + c[:, 1]
-    order = np.argsort(key, kind="stable")
-    skey = key[order]
-    best, bi, bj = 0.0, -1, -1
-    for dx in (-1, 0, 1):
-        for dy in (-1, 0, 1):
-            target = key + dx * ny + dy
-            lo = np.searchsorted(skey, target, "left")
-            hi = np.searchsorted(skey, target, "right")
-            cnt = hi - lo
-            total = int(cnt.sum())
-            if total == 0:
-                continue
-            i = np.repeat(np.arange(n), cnt)
-            j = order[np.repeat(lo, cnt) + np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt)]
-            keep = i < j
-            if among is not None:
-                keep &= among[i] | among[j]
-            i, j = i[keep], j[keep]
-            u = r[i] + r[j] - np.linalg.norm(x[j] - x[i], axis=1)
-            rel = u / np.minimum(r[i], r[j])
-            if rel.size:
-                k = int(np.argmax(rel))
-                if rel[k] > best:
-                    best, bi, bj = float(rel[k]), int(i[k]), int(j[k])
-    return best, bi, bj
+    i, j = _pairs(x, h, h)
+    if among is not None:
+        keep = among[i] | among[j]
+        i, j = i[keep], j[keep]
+    rel = (r[i] + r[j] - np.linalg.norm(x[j] - x[i], axis=1)) / np.minimum(r[i], r[j])
+    if rel.size == 0 or rel.max() <= 0.0:
+        return 0.0, -1, -1
+    k = int(np.argmax(rel))
+    return float(rel[k]), int(i[k]), int(j[k])
