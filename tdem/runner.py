@@ -422,14 +422,19 @@ class Runner:
         return a["flags"].to_numpy()
 
     def _warn_dense_packing(self, dt):
-        """Warn once per time step value when it exceeds the stable step of a dense
-        packing of the particles (:meth:`tdem.Simulation.stable_dt`); not for models
-        of fewer than seven particles (no particle can have six contacts)."""
-        if self._n < 7 or getattr(self, "_dense_warned", None) == dt:
+        """Warn when the step exceeds the stable step of a dense packing of the
+        particles (:meth:`tdem.Simulation.stable_dt`); not for models of fewer than
+        seven particles (no particle can have six contacts). Checked again only when
+        the step, the particles or the laws have changed."""
+        key = (dt, self._n, len(self._walls_host), len(self._pair_override),
+               tuple((type(law).__name__, tuple(law.values()),
+                      law.rolling.delta if law.rolling is not None else 0.0)
+                     for law in self._laws))
+        if self._n < 7 or getattr(self, "_dense_checked", None) == key:
             return
+        self._dense_checked = key
         stable = self.stable_dt()
         if dt > stable:
-            self._dense_warned = dt
             crit = self.critical_dt()
             warnings.warn(
                 f"dt = {dt:.4g} s is above {stable:.4g} s, the stable step of a dense "

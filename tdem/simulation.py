@@ -642,18 +642,19 @@ class Simulation(Runner, Results):
             if self._blocks:
                 return crit
             raise InputError("the critical time step needs particles: add some first")
-        r = self._radii()
-        if self._built:
-            m = self._a["prop"].to_numpy()[:, 1]
-            plaw = self._a["plaw"].to_numpy()
-        else:
-            rho = np.concatenate(self._host["density"])
-            m = rho * np.pi * r ** 2
-            plaw = np.concatenate(self._host["law"])
+        r, m, plaw = self._masses()
         for sel, law in self._laws_met(plaw):
             k = law.critical_stiffness(r[sel], m[sel])
             crit = min(crit, float(np.min(2.0 * np.sqrt(m[sel] / k))))
         return crit
+
+    def _masses(self):
+        """(radius, mass, law group) of every particle, from the device once built."""
+        r = self._radii()
+        if self._built:
+            return r, self._a["prop"].to_numpy()[:, 1], self._a["plaw"].to_numpy()
+        m = np.concatenate(self._host["density"]) * np.pi * r ** 2
+        return r, m, np.concatenate(self._host["law"])
 
     def _laws_met(self, plaw):
         """(particles, law) for each law group present and each law its particles
@@ -678,13 +679,7 @@ class Simulation(Runner, Results):
         :meth:`critical_dt`)."""
         if self._n == 0:
             return math.inf
-        r = self._radii()
-        if self._built:
-            m = self._a["prop"].to_numpy()[:, 1]
-            plaw = self._a["plaw"].to_numpy()
-        else:
-            m = np.concatenate(self._host["density"]) * np.pi * r ** 2
-            plaw = np.concatenate(self._host["law"])
+        r, m, plaw = self._masses()
         dem = np.concatenate(self._host["mat"]) < 0       # PCMM particles: elements
         out = math.inf
         for sel, law in self._laws_met(plaw):
