@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from .errors import InputError
+from .pack import _polygon_area
 
 
 class Region:
@@ -52,8 +53,7 @@ class Region:
                 p = np.asarray(polygon, dtype=float)
                 if p.ndim != 2 or p.shape[1] != 2 or len(p) < 3 or not np.isfinite(p).all():
                     raise ValueError
-                x, y = p[:, 0], p[:, 1]
-                self.area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+                self.area = abs(float(_polygon_area(p)))
                 if self.area <= 0:
                     raise ValueError
                 from matplotlib.path import Path
