@@ -13,7 +13,10 @@ Superellipse (Miyata et al. 2002, Eq. 34): |x/a|ⁿ + |y/b|ⁿ = 1, 2 ≤ n ≤ 
   J = (4/3)(a³b + ab³)·Γ(1+3/n)Γ(1+1/n)/Γ(1+4/n);
 - support function h(u) = ‖(a·u_x, b·u_y)‖_q, q = n/(n − 1), and support point
   ∇h(u) (the boundary point of outward normal u);
-- n = 2, a = b is a disc of radius a and gives the disc results.
+- n = 2, a = b is a disc of radius a and gives the disc results;
+- the bounding radius (the neighbour grid's) is the largest distance of a boundary
+  point from the centre: max(a, b) for n = 2 only — for n > 2 the corners reach
+  beyond it (PHYSICS §7 says max(a, b), which would miss contacts at the corners).
 """
 import math
 
@@ -65,8 +68,13 @@ class Superellipse:
 
     @property
     def bounding_radius(self):
-        """Radius of the smallest centred circle that holds the shape: max(a, b)."""
-        return max(self.a, self.b)
+        """Radius of the smallest centred circle that holds the shape (m): the largest
+        |p| over the boundary. It is max(a, b) only for n = 2: for n > 2 the corners
+        reach beyond (a square of n = 4 to 2^(1/4) a). By a dense scan of the boundary,
+        widened by 1e-6 (the scan's error is far below)."""
+        if self.n == 2.0:
+            return max(self.a, self.b)
+        return float(np.linalg.norm(self.outline(200_000), axis=1).max()) * (1.0 + 1e-6)
 
     @property
     def inscribed_radius(self):

@@ -42,6 +42,11 @@ F_BUILDS = 4     # number of list builds so far
 F_NONCONV = 5    # shaped-particle contact evaluations whose iteration stopped short
 FLAGS_SIZE = 8
 
+# columns of the float parameter array ``simp`` (the step's and the search's)
+P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
+P_PX0, P_PLX, P_PY0, P_PLY = 7, 8, 9, 10      # periodic axes: start, length (0: none)
+SIMP_SIZE = 12
+
 
 @ti.func
 def slot_bits(cap):
@@ -55,9 +60,23 @@ def slot_bits(cap):
 
 @ti.func
 def cell_of(x, gridp: ti.template(), nx: ti.i32, ny: ti.i32):
+    """The cell (cx, cy) of point x: cells of side gridp[2] along x and gridp[3] along y
+    from the corner (gridp[0], gridp[1]), clamped to the grid."""
     cx = ti.cast(ti.floor((x[0] - gridp[0]) / gridp[2]), ti.i32)
-    cy = ti.cast(ti.floor((x[1] - gridp[1]) / gridp[2]), ti.i32)
+    cy = ti.cast(ti.floor((x[1] - gridp[1]) / gridp[3]), ti.i32)
     return ti.math.clamp(cx, 0, nx - 1), ti.math.clamp(cy, 0, ny - 1)
+
+
+@ti.func
+def image(d, per):
+    """The nearest periodic image of the offset d: per = (x0, Lx, y0, Ly), a length 0
+    where the axis is not periodic (PHYSICS §8: contacts across the boundary are
+    between images)."""
+    if per[1] > 0.0:
+        d[0] -= per[1] * ti.round(d[0] / per[1])
+    if per[3] > 0.0:
+        d[1] -= per[3] * ti.round(d[1] / per[3])
+    return d
 
 
 @cached
@@ -71,11 +90,13 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             gridp: ti.types.ndarray(), gridn: ti.types.ndarray(), flags: ti.types.ndarray(),
             wall: ti.types.ndarray(), wid: ti.types.ndarray(), whist: ti.types.ndarray(),
             wid_old: ti.types.ndarray(), whist_old: ti.types.ndarray(), nwalls: ti.i32,
-            skin: ti.f64):
+            skin: ti.f64, simp: ti.types.ndarray()):
     n = pos.shape[0]
     cap = nbr.shape[1]
     nx = gridn[0]
     ny = gridn[1]
+    # periodic axes (their cells tile the period exactly; tdem.runner._fit_grid)
+    per = ti.Vector([simp[P_PX0], simp[P_PLX], simp[P_PY0], simp[P_PLY]])
     ncell = nx * ny
     # 1. keep the old lists (for the history), clear the cell counts
     for i in range(n):
@@ -133,12 +154,16 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                 for dx in ti.static(range(-1, 2)):
                     ccx = cx + dx
                     ccy = cy + dy
+                    if per[1] > 0.0:
+                        ccx = (ccx + nx) % nx
+                    if per[3] > 0.0:
+                        ccy = (ccy + ny) % ny
                     if 0 <= ccx < nx and 0 <= ccy < ny:
                         c = ccy * nx + ccx
                         for s in range(cell_start[c], cell_start[c] + cell_count[c]):
                             j = sorted_ids[s]
                             if j != i:
-                                d = pos[j] - xi
+                                d = image(pos[j] - xi, per)
                                 cut = ri + prop[j][PROP_RADIUS] + skin
                                 if d.dot(d) < cut * cut:
                                     if j > i:

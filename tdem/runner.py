@@ -203,6 +203,10 @@ class Runner:
         p[stepk.P_ALPHA_LOCAL] = self.local_damping
         p[stepk.P_SKIN] = self.skin
         p[stepk.P_NWALLS] = len(self._walls_host)
+        for (c0, cl), span in zip(((stepk.P_PX0, stepk.P_PLX), (stepk.P_PY0, stepk.P_PLY)),
+                                  self._periodic):
+            if span is not None:
+                p[c0], p[cl] = span[0], span[1] - span[0]
         self._a["simp"].from_numpy(p)
         self._dt_run = p[stepk.P_DT]
 
@@ -253,6 +257,9 @@ class Runner:
         if not np.all(np.isfinite(b)) or hi[0] < lo[0]:
             return
         h = 2.0 * rmax + self.skin
+        if any(p is not None for p in self._periodic):
+            self._fit_periodic_grid(lo, hi, h, force)
+            return
         gp = a["gridp"].to_numpy()
         gn = a["gridn"].to_numpy()
         self._last_fit = self._steps
@@ -288,14 +295,60 @@ class Runner:
             h *= 1.5
             nx, ny = cells(lo, hi, h)
         lo = lo - margin
+        self._set_grid(lo, (h, h), (nx, ny))
+
+    def _set_grid(self, lo, h, counts):
+        a = self._a
+        nx, ny = (int(c) for c in counts)
         ncap = a["cell_count"].shape[0]
         if nx * ny > ncap or ny > 4096:
             self._a["cell_count"] = ti.ndarray(ti.i32, (int(nx * ny),))
             self._a["cell_start"] = ti.ndarray(ti.i32, (int(nx * ny) + max(int(ny), 4096),))
-        a["gridp"].from_numpy(np.array([lo[0], lo[1], h, 0.0]))
+        a["gridp"].from_numpy(np.array([lo[0], lo[1], h[0], h[1]], dtype=float))
         a["gridn"].from_numpy(np.array([nx, ny, 0, 0], dtype=np.int32))
         a["flags"][F_REBUILD] = 1
         self._last_fit = self._steps
+
+    def _fit_periodic_grid(self, lo, hi, h, force):
+        """The grid when an axis is periodic: along it the cells tile the period exactly
+        (at least three, so that the neighbour cells across the boundary are distinct);
+        along an open axis as :meth:`_fit_grid` (cells of side h, with a margin; clamped
+        at the edges). Refits whenever the particles' box or size calls for it."""
+        a = self._a
+        gp = a["gridp"].to_numpy()
+        gn = a["gridn"].to_numpy()
+        origin, sides, counts = [0.0, 0.0], [h, h], [1, 1]
+        for k, span in enumerate(self._periodic):
+            if span is not None:
+                length = span[1] - span[0]
+                c = int(math.floor(length / h))
+                if c < 3:
+                    raise InputError(
+                        f"periodic: the {'xy'[k]} period {length:g} m must hold three cells of "
+                        f"the neighbour grid (2 × the largest radius + the skin = {h:g} m each), "
+                        f"i.e. be >= {3 * h:g} m")
+                origin[k], sides[k], counts[k] = span[0], length / c, c
+            else:
+                margin = 2 * h
+                c = int(np.floor((hi[k] - lo[k] + 2 * margin) / h)) + 1
+                origin[k], counts[k] = lo[k] - margin, c
+        # keep the grid while the periodic cells are unchanged and the particles of an
+        # open axis stay inside it, in cells not too large for them
+        same = all(gn[j] == counts[j] and abs(gp[2 + j] - sides[j]) <= 1e-12 * sides[j]
+                   for j in range(2) if self._periodic[j] is not None)
+        for k in range(2):
+            if self._periodic[k] is None:
+                same = same and lo[k] >= gp[k] and hi[k] <= gp[k] + gp[2 + k] * gn[k] and \
+                    gp[2 + k] >= h and (hi[k] - lo[k]) / gp[2 + k] + 1 > 0.25 * gn[k]
+        if same and not force:
+            return
+        while counts[0] * counts[1] > self._cell_limit():
+            k = 0 if self._periodic[0] is None else 1
+            if self._periodic[k] is not None:
+                break
+            sides[k] *= 1.5
+            counts[k] = int(np.floor((hi[k] - lo[k] + 4 * h) / sides[k])) + 1
+        self._set_grid(origin, sides, counts)
 
     def _apply_fixes(self, initial=False, t=None):
         """Upload prescribed velocities: all of them (``initial``), else only the values

@@ -18,7 +18,7 @@ from physics.contact_law import history_width, law_force, zero_history
 from physics.geometry import superellipse as se
 from physics.geometry.frame import perp, tangent_part, tangent_vector
 
-from .neighbors import F_NONCONV
+from .neighbors import F_NONCONV, image
 from .state import PROP_MASS, PROP_RADIUS
 
 
@@ -42,7 +42,7 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
                 plaw: ti.template(), angle: ti.template(), shp: ti.template(),
                 lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                 hist: ti.template(), cn: ti.template(), cs: ti.template(),
-                flags: ti.template(), dt, detail: ti.template(), laws: ti.template()):
+                flags: ti.template(), dt, detail: ti.template(), laws: ti.template(), per):
     """Contact in slot k of particle i (the owner) when either body has a shape;
     returns (f_i, M_i, M_j, dissipated energy), as :func:`tdem.step.pair_contact`."""
     R = ti.static(history_width(laws))
@@ -53,8 +53,8 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
     rbj = pj[PROP_RADIUS]
     shj = shape_of(shp[j], rbj)
     thj = angle[j]
-    xj = pos[j]
-    d = xj - xi
+    d = image(pos[j] - xi, per)        # j at its image nearest to i
+    xj = xi + d
     h = hist[i, k]
     f = ti.Vector([0.0, 0.0])
     m_on_i = 0.0

@@ -151,6 +151,7 @@ class Simulation(Runner, Results):
         self._nonreflect = []      # ("p" | "v", ids, coef rows) of viscous boundaries
         self._lights = []          # (ids, lighting times) of JWL particles, before the build
         self._walls_host = []      # rows of the wall table
+        self._periodic = [None, None]   # (start, end) of the periodic x and y axes
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
         self._built = False
@@ -189,12 +190,47 @@ class Simulation(Runner, Results):
         self._laws.append(law)
         return len(self._laws) - 1
 
+    def periodic(self, x=None, y=None):
+        """Make the x and/or y axis periodic over [x0, x1) (and [y0, y1)): particles that
+        leave on one side come back on the other, the neighbour search and the contacts
+        see across the boundary (between images), walls and output are unaffected.
+        ``None`` leaves an axis as it is; ``False`` makes it open again. The period
+        must hold three cells of the neighbour grid (2 × the largest radius + the skin
+        each), checked when a run starts. PCMM particles and blocks cannot be periodic.
+        """
+        new = list(self._periodic)
+        for k, (name, v) in enumerate((("x", x), ("y", y))):
+            if v is None:
+                continue
+            if v is False:
+                new[k] = None
+                continue
+            try:
+                lo, hi = (float(c) for c in v)
+            except (TypeError, ValueError):
+                raise InputError(f"{name} must be a pair (start, end) of numbers, got "
+                                 f"{v!r}") from None
+            if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
+                raise InputError(f"{name} must be (start, end) with start < end, both "
+                                 f"finite, got {v!r}")
+            new[k] = (lo, hi)
+        if any(p is not None for p in new) and (self._slots or self._blocks):
+            raise InputError("periodic: PCMM particles and blocks cannot be periodic (their "
+                             "elements would span the boundary)")
+        self._periodic = new
+        if self._built:
+            self._upload_params()
+            if self._n:
+                self._fit_grid(force=True)
+        return self
+
     def add_particles(self, positions, radius=None, density=2500.0, contact=None,
                       material=None, tolerance=0.0, velocity=None, shape=None, angle=None):
         """Add discs (``radius``) or shaped particles (``shape``, e.g.
         :class:`tdem.Superellipse`, turned by ``angle``: degrees, counter-clockwise, a
         number or one per particle; default 0); returns a :class:`ParticleGroup`
-        (``.ids`` their indices). A shape's bounding radius max(a, b) serves as the
+        (``.ids`` their indices). A shape's bounding radius (the largest distance of its boundary from
+        its centre) serves as the
         particle's radius (neighbour search, output); its mass and inertia are the
         shape's. Shaped particles take the linear or Hertz–Mindlin law (no rolling
         resistance) and cannot be PCMM particles.
@@ -696,10 +732,13 @@ class Simulation(Runner, Results):
             k = law.critical_stiffness(r[sel], m[sel])
             crit = min(crit, float(np.min(2.0 * np.sqrt(m[sel] / k))))
             if inertia is not None and (sel & shaped).any():
-                # a shape also turns: 2·sqrt(I/(k r_b²)) (PHYSICS §7)
+                # a shape also turns under a contact force: its contact point moves as a
+                # mass m* = 1/(1/m + r_b²/I), which is below both m and the I/r_b² of
+                # PHYSICS §7's 2·sqrt(I/(k r_b²)): 2·sqrt(m*/k) bounds both
                 rot = sel & shaped
                 kr = law.critical_stiffness(r[rot], m[rot])
-                crit = min(crit, float(np.min(2.0 * np.sqrt(inertia[rot] / (kr * r[rot] ** 2)))))
+                mstar = 1.0 / (1.0 / m[rot] + r[rot] ** 2 / inertia[rot])
+                crit = min(crit, float(np.min(2.0 * np.sqrt(mstar / kr))))
         return crit
 
     def _shaped_mask(self):

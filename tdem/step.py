@@ -24,13 +24,12 @@ from physics.rolling import rolling_couple, rolling_energy
 from .finite import any_non_finite, non_finite
 from .integrate import damped_leapfrog
 from .launch import cached
-from .neighbors import F_BAD, F_REBUILD, slot_bits
+from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY,  # noqa: F401
+                        P_NWALLS, P_PLX, P_PLY, P_PX0, P_PY0, P_SKIN, SIMP_SIZE, image,
+                        slot_bits)
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
-# columns of the float parameter array ``simp``
-P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
-SIMP_SIZE = 8
 # columns of the wall array: p0, p1, translation velocity, angular velocity, centre, law
 # W_INVLL = 1/|p1 − p0|²; W_DISP = largest displacement of the wall since the lists were built;
 # servo control: W_SERVO_K > 0 switches it on (stiffness of one contact), target force
@@ -47,10 +46,11 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
                  omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                  lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                  hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-                 detail: ti.template(), laws: ti.template()):
+                 detail: ti.template(), laws: ti.template(), per):
     """Contact in slot k of particle i (the owner, i < j); xi, vi, wi, ri, mi, li are
     i's position, velocity, spin, radius, mass and law group; ``laws`` the registered
-    contact laws (:mod:`physics.contact_law`).
+    contact laws (:mod:`physics.contact_law`); ``per`` the periodic axes (j is taken
+    at its image nearest to i).
 
     Updates the history and returns (f_i, M_i, M_j, dissipated energy). With
     ``detail`` also stores the normal, the scalar forces and the overlap (for
@@ -62,7 +62,7 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     j = nbr[i, k]
     pj = prop[j]
     rj = pj[PROP_RADIUS]
-    d, dist, u_geo = disc_disc.overlap(xi, pos[j], ri, rj)
+    d, dist, u_geo = disc_disc.overlap(xi, xi + image(pos[j] - xi, per), ri, rj)
     # a pair that shared PCMM elements until recently counts its overlap from the
     # overlap it had when they stopped carrying it (hist[U0], recorded by
     # physics.pcmm.gather, lowered as the two separate): the contact law takes over
@@ -222,7 +222,8 @@ def servo_velocity(wall: ti.template(), wforce: ti.template(), w, dt):
 def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
          angle: ti.types.ndarray(), shp: ti.types.ndarray(), prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
          vfix: ti.types.ndarray(), force: ti.types.ndarray(), torque: ti.types.ndarray(),
-         xref: ti.types.ndarray(), facc: ti.types.ndarray(), eacc: ti.types.ndarray(),
+         xref: ti.types.ndarray(), pos0: ti.types.ndarray(), facc: ti.types.ndarray(),
+         eacc: ti.types.ndarray(),
          estate: ti.types.ndarray(),
          nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
          cn: ti.types.ndarray(), cf: ti.types.ndarray(), cs: ti.types.ndarray(),
@@ -252,6 +253,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     alpha = simp[P_ALPHA]
     alpha_l = simp[P_ALPHA_LOCAL]
     half_skin2 = (0.5 * simp[P_SKIN]) ** 2
+    per = ti.Vector([simp[P_PX0], simp[P_PLX], simp[P_PY0], simp[P_PLY]])
 
     ti.loop_config(serialize=True)
     for w in range(nw):
@@ -305,11 +307,11 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     fk, mk, mjk, dk = shaped_pair(
                         i, k, xi, vi, wi, pi[PROP_MASS], li, thi, shi, pi[PROP_RADIUS], pos,
                         vel, omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs,
-                        flags, dt, detail, laws)
+                        flags, dt, detail, laws, per)
                 else:
                     fk, mk, mjk, dk = pair_contact(
                         i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
-                        prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws)
+                        prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws, per)
             f += fk
             tq += mk
             diss += dk
@@ -391,6 +393,17 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             estate[i] = ti.Vector([0.5 * m * vm.dot(vm) + 0.5 * inertia * wm * wm,
                                    -m * g.dot(x0)])
         x1 = x0 + v1 * dt
+        # periodic axes: back into [x0, x0 + L), with the references the displacement
+        # and the skin check count from
+        shift = ti.Vector([0.0, 0.0])
+        if per[1] > 0.0:
+            shift[0] = per[1] * ti.floor((x1[0] - per[0]) / per[1])
+        if per[3] > 0.0:
+            shift[1] = per[3] * ti.floor((x1[1] - per[2]) / per[3])
+        if shift[0] != 0.0 or shift[1] != 0.0:
+            x1 -= shift
+            xref[i] -= shift
+            pos0[i] -= shift
         vel[i] = v1
         omega[i] = w1
         pos[i] = x1

@@ -46,6 +46,22 @@ def test_area_inertia_and_support_against_a_fine_polygon(s):
     np.testing.assert_allclose((sp * u).sum(1), h, rtol=1e-12)
 
 
+@pytest.mark.parametrize("s", SHAPES, ids=repr)
+def test_bounding_radius_holds_the_whole_boundary(s):
+    """PHYSICS §7 gives max(a, b); for n > 2 the corners reach beyond it (a square of
+    n = 4 to 2^(1/4) a), and the neighbour search would miss corner contacts."""
+    far = np.linalg.norm(_polygon(s, 1_000_000), axis=1).max()
+    assert far <= s.bounding_radius <= far * (1 + 2e-6)
+    if s.n == 2.0:
+        assert s.bounding_radius == max(s.a, s.b)
+    else:
+        assert s.bounding_radius > 1.005 * max(s.a, s.b)
+
+
+def test_square_superellipse_reaches_two_to_the_quarter():
+    assert Superellipse(1.0, 1.0, 4).bounding_radius == pytest.approx(2 ** 0.25, rel=2e-6)
+
+
 def test_disc_shape_has_the_disc_mass_and_inertia():
     s = Superellipse(0.1, 0.1, 2)
     assert s.area == pytest.approx(math.pi * 0.01, rel=1e-14)
@@ -222,4 +238,6 @@ def test_box_tips_only_where_tan_exceeds_width_over_height(deg, tips):
         assert turned > 60.0
     else:
         assert turned < 1.0
-        assert abs(sim.particles.numpy()["position"][0, 0]) < 1e-3
+        # it stays (sliding freely it would go 7.8 m): the shear spring's give and the
+        # rocking of its single contact point let it creep by millimetres
+        assert abs(sim.particles.numpy()["position"][0, 0]) < 5e-3

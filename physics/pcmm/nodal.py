@@ -12,7 +12,7 @@ import taichi as ti
 from tdem.launch import cached
 from tdem.state import PROP_RADIUS
 
-from ..contact_law import zero_history
+from ..contact_law import PAIR_TAIL, zero_history
 from ..materials import FLUID, JWL_TYPE, MAT_K, MAT_TYPE
 from .layout import P_BUILT, P_NEW
 from .stress import _corner_force, _has_eos, _unpack2
@@ -130,12 +130,12 @@ def _set_skip(i, k, j, skip, pos: ti.template(), prop: ti.template(), cskip: ti.
               hist: ti.template()):
     """Pair slot k of i (partner j) takes the mark ``skip`` (see :func:`gather`). The
     pair's history says whether elements carried it at the last mark: its overlap
-    entry (u0, the last column) is CARRIED (< 0) then, an overlap ≥ 0 otherwise. A pair that elements
+    entry (u0, the first column of contact_law.PAIR_TAIL) is CARRIED (< 0) then, an overlap ≥ 0 otherwise. A pair that elements
     stop carrying starts the contact law afresh, counting from its overlap now
     (:func:`tdem.step.pair_contact`), so that the law takes over without a jump."""
     cskip[i, k] = skip
     h = hist[i, k]
-    u0 = ti.static(h.n - 1)
+    u0 = ti.static(h.n - len(PAIR_TAIL) + PAIR_TAIL.index("u0"))
     if skip == 1:
         if h[u0] >= 0.0:
             h[u0] = CARRIED
