@@ -73,6 +73,7 @@ def _config(sim):
         "built": bool(sim._built),
         "slots": [{"material": m.to_dict(), "tolerance": t} for m, t in sim._slots],
         "continuum_capacity": int(sim._cont.capacity) if sim._cont is not None else 0,
+        "periodic": [None if p is None else [float(p[0]), float(p[1])] for p in sim._periodic],
         "couples": [{"ids": None if ids is None else [int(i) for i in ids],
                      "a": None if a is None else int(a.index), "block": int(b.index),
                      "law": law.to_dict()} for ids, a, b, law in sim._couples],
@@ -524,6 +525,7 @@ def load(path, arch=None):
         ids = np.arange(gd["first"], gd["first"] + gd["count"])
         sim._groups.append(ParticleGroup(sim, ids, sim._laws[gd["law"]], rho))
     sim._walls_host = list(host["walls"])
+    sim._periodic = [None if p is None else tuple(p) for p in cfg.get("periodic", [None, None])]
     sim._fixes = fixes
     sim._n = cfg["n"]
     sim._cap = cfg["cap"]

@@ -10,6 +10,7 @@ import numpy as np
 import taichi as ti
 
 from physics import contact_law as _claw
+from physics.shapes import Superellipse
 
 from . import state as schema
 from . import step as stepk
@@ -101,12 +102,13 @@ class Results:
         jj = nbr[ii, kk]
         u = cs[ii, kk, 2]
         normal_dir = cn[ii, kk]
-        pts = pos[ii] + (r[ii] - 0.5 * u)[:, None] * normal_dir
         wcs = a["wcs"].to_numpy()
         wid = a["wid"].to_numpy()
         wi, wk = np.nonzero((wid >= 0) & (wcs[:, :, 2] > 0))
         wu = wcs[wi, wk, 2]
         wn = a["wcn"].to_numpy()[wi, wk]
+        pts = pos[ii] + self._arms(ii, normal_dir, u, r)
+        wpts = pos[wi] + self._arms(wi, wn, wu, r)
         whist = a["whist"].to_numpy()
         R = _claw.history_width(self._law_set)     # the rolling couple's column
         return {
@@ -117,8 +119,34 @@ class Results:
             "moment": np.concatenate([hist[ii, kk, R], whist[wi, wk, R]]),
             "direction": np.concatenate([normal_dir, wn]),
             "overlap": np.concatenate([u, wu]),
-            "point": np.concatenate([pts, pos[wi] + (r[wi] - 0.5 * wu)[:, None] * wn]),
+            "point": np.concatenate([pts, wpts]),
         }
+
+    def _arms(self, ids, n, u, r):
+        """From the centres of particles ``ids`` to their contact points (outward normal
+        n, overlap u): (R − u/2) n for a disc, its support point less u/2 along n for a
+        shape (the midpoint of the two bodies' support points)."""
+        arm = (r[ids] - 0.5 * u)[:, None] * n
+        if self._has_shapes and len(ids):
+            rows = np.concatenate(self._host["shape"])[ids]
+            th = self._a["angle"].to_numpy()[ids]
+            for key in np.unique(rows[rows[:, 2] > 0, :3], axis=0):
+                sel = np.flatnonzero(np.all(rows[:, :3] == key, axis=1))
+                c, s_ = np.cos(th[sel]), np.sin(th[sel])
+                nb = np.stack([c * n[sel, 0] + s_ * n[sel, 1], -s_ * n[sel, 0] + c * n[sel, 1]], 1)
+                _, pb = Superellipse(*key).support(nb)
+                pw = np.stack([c * pb[:, 0] - s_ * pb[:, 1], s_ * pb[:, 0] + c * pb[:, 1]], 1)
+                arm[sel] = pw - 0.5 * u[sel, None] * n[sel]
+        return arm
+
+    def _image(self, d):
+        """Offsets ``d`` (…, 2) to their nearest periodic image."""
+        d = np.array(d, dtype=float)
+        for k, span in enumerate(getattr(self, "_periodic", (None, None))):
+            if span is not None:
+                length = span[1] - span[0]
+                d[..., k] -= length * np.round(d[..., k] / length)
+        return d
 
     def _elements_numpy(self):
         """PCMM elements now (copies included): triangles (E, 3) of particle indices,
