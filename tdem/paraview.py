@@ -17,7 +17,7 @@ It opens the series and shows, at the last snapshot (``--time T`` for another):
   explosives), on a diverging scale symmetric about zero;
 - the contacts as tubes whose radius is proportional to |normal force| (*Calculator*
   → *Threshold* |F_n| > 0 → *Extract Surface* → *Tube* varying its radius by that
-  scalar), the largest ``TUBE`` × the mean disc radius, coloured by ``normal_force``;
+  scalar), the largest ``TUBE`` × the median disc radius, coloured by ``normal_force``;
 - the walls as thick lines, point–edge couplings as thin lines;
 
 and, run as a program, saves a PNG screenshot (``view.png`` beside the script, or
@@ -30,6 +30,7 @@ The placeholder cell of an empty file (no walls, no contacts yet; see
 neither shows nor moves the camera.
 """
 import os
+import random
 import shutil
 import subprocess
 import sys
@@ -76,11 +77,11 @@ def _series_in(directory):
 
 
 def view_script(series, field=DEFAULT_FIELD, disc_field=None, title="", png="view.png",
-                size=(1600, 1200), tube=0.3):
+                size=(1600, 1200), tube=0.25):
     """The text of a ``view.py`` for the ``series`` {kind: .pvd file name relative to
     the script} (kinds of :data:`KINDS`). ``field``: the colour of elements and blocks;
     ``disc_field``: a particle array to colour discs by (None: plain grey); ``tube``:
-    the radius of the largest contact force's tube over the mean disc radius."""
+    the radius of the largest contact force's tube over the median disc radius."""
     unknown = sorted(set(series) - set(KINDS))
     if unknown:
         raise InputError(f"series: unknown kind {unknown[0]!r}; the kinds are {KINDS}")
@@ -88,7 +89,7 @@ def view_script(series, field=DEFAULT_FIELD, disc_field=None, title="", png="vie
             int(s) == s and s >= 16 for s in size)):
         raise InputError(f"size must be (width, height) in pixels, got {size!r}")
     if not float(tube) > 0:
-        raise InputError(f"tube must be > 0 (a fraction of the mean radius), got {tube!r}")
+        raise InputError(f"tube must be > 0 (a fraction of the median radius), got {tube!r}")
     settings = "\n".join([
         f"SERIES = {dict((k, series[k]) for k in KINDS if k in series)!r}",
         f"FIELD = {str(field)!r}  # colour of elements and blocks",
@@ -97,7 +98,7 @@ def view_script(series, field=DEFAULT_FIELD, disc_field=None, title="", png="vie
         f"TITLE = {str(title)!r}",
         f"PNG = {str(png)!r}  # beside this script",
         f"SIZE = {[int(size[0]), int(size[1])]!r}  # pixels",
-        f"TUBE = {float(tube)!r}  # largest contact tube radius / mean disc radius",
+        f"TUBE = {float(tube)!r}  # largest contact tube radius / median disc radius",
     ])
     return _HEADER + settings + "\n" + _BODY
 
@@ -142,8 +143,16 @@ def view_command(directory, args=()):
     cmd = [exe, str(Path(directory) / SCRIPT_NAME), *map(str, args)]
     if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY") \
             and shutil.which("xvfb-run"):
-        cmd = ["xvfb-run", "-a", *cmd]
+        # -a: the first free display from -n on; a random start keeps two renders
+        # started at the same moment off the same display
+        cmd = ["xvfb-run", "-a", "-n", str(random.randint(100, 9999)), *cmd]
     return cmd
+
+
+def _x_failed(proc):
+    return proc.returncode != 0 and any(
+        k in (proc.stderr or "") for k in ("bad X server connection", "Xvfb failed",
+                                           "cannot open display"))
 
 
 def render(directory, args=(), timeout=600, write=True, **kw):
@@ -158,7 +167,11 @@ def render(directory, args=(), timeout=600, write=True, **kw):
     if cmd is None:
         raise RuntimeError("pvpython is not on PATH: install ParaView (e.g. apt-get "
                            "install paraview xvfb) to render the pictures")
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    if _x_failed(proc):        # the virtual display did not come up: once more
+        proc = subprocess.run(view_command(directory, args), capture_output=True, text=True,
+                              timeout=timeout)
+    return proc
 
 
 def main(argv=None):
@@ -196,7 +209,11 @@ def main(argv=None):
               f"paraview --script={script}")
         return 1
     print(" ".join(cmd), flush=True)
-    return subprocess.run(cmd).returncode
+    proc = subprocess.run(cmd, stderr=subprocess.PIPE, text=True)
+    if _x_failed(proc):
+        proc = subprocess.run(view_command(d, rest), stderr=subprocess.PIPE, text=True)
+    sys.stderr.write(proc.stderr or "")
+    return proc.returncode
 
 
 _HEADER = '''"""ParaView picture of this folder's tdem series (written by tdem.paraview).
@@ -284,6 +301,21 @@ def array_range(src, assoc, name, t):
     return list(data[name].GetRange(-1 if data[name].GetNumberOfComponents() > 1 else 0))
 
 
+def median_radius(src, t):
+    """The median of the particles' radius array at time ``t``."""
+    from paraview import servermanager
+    from vtk.numpy_interface import dataset_adapter as dsa
+    src.UpdatePipeline(t)
+    data = dsa.WrapDataObject(servermanager.Fetch(src))
+    r = data.PointData["radius"]
+    try:
+        import numpy
+        return float(numpy.median(numpy.asarray(r)))
+    except Exception:   # no numpy in this ParaView: the middle of the range
+        lo, hi = src.PointData["radius"].GetRange()
+        return 0.5 * (lo + hi)
+
+
 def association(src, name, t):
     src.UpdatePipeline(t)
     if name in src.CellData.keys():
@@ -291,6 +323,11 @@ def association(src, name, t):
     if name in src.PointData.keys():
         return "POINTS"
     return None
+
+
+def flat(rep):
+    """Colours as they are on the colour bar: no shading of the flat things."""
+    rep.Ambient, rep.Diffuse, rep.Specular = 1.0, 0.0, 0.0
 
 
 def colour_bar(view, lut, title, show):
@@ -351,6 +388,7 @@ def main():
         src = threshold(readers[kind], assoc, arr, 0.0, kind + "_cells")
         rep = Show(src, view)
         rep.SetRepresentationType("Surface With Edges" if kind == "blocks" else "Surface")
+        flat(rep)
         rep.EdgeColor = [0.35, 0.35, 0.35]
         where = association(src, args.field, t)
         if where is not None:
@@ -366,7 +404,7 @@ def main():
     if "particles" in readers:
         src = threshold(readers["particles"], "POINTS", "id", 0.0, "particles_valid")
         ring = "elements" in readers
-        disk = Disk(registrationName="disc", InnerRadius=0.42 if ring else 0.0,
+        disk = Disk(registrationName="disc", InnerRadius=0.465 if ring else 0.0,
                     OuterRadius=0.5, CircumferentialResolution=64, RadialResolution=1)
         discs = GlyphWithCustomSource(registrationName="discs", Input=src, GlyphSource=disk)
         discs.ScaleArray = ["POINTS", "radius"]
@@ -376,21 +414,22 @@ def main():
         if ring:                          # just above the elements (z = 0.02 r)
             discs.GlyphTransform.Translate = [0.0, 0.0, 0.01]
         rep = Show(discs, view)
-        rep.Ambient, rep.Diffuse = 0.25, 0.75
+        flat(rep)
         if DISC_FIELD:
             ColorBy(rep, ("POINTS", DISC_FIELD))
         else:
             rep.ColorArrayName = ["POINTS", ""]
             rep.AmbientColor = rep.DiffuseColor = (
-                [0.25, 0.25, 0.25] if ring else [0.80, 0.80, 0.80])
+                [0.3, 0.3, 0.3] if ring else [0.80, 0.80, 0.80])
         shown["particles"] = discs
         info["particles"] = count(src, t)
         info["discs"] = {"bounds": bounds(discs, t)}
         rr = array_range(src, "POINTS", "radius", t)
         info["particles"]["radius"] = rr
-        r_mean = 0.5 * (rr[0] + rr[1]) if rr else None
+        r_typical = median_radius(src, t) if rr else None
+        info["particles"]["median_radius"] = r_typical
     else:
-        r_mean = None
+        r_typical = None
 
     # walls and couplings: lines
     for kind, width, colour in (("walls", 4.0, [0.1, 0.1, 0.1]),
@@ -400,6 +439,7 @@ def main():
         assoc, arr = VALID[kind]
         src = threshold(readers[kind], assoc, arr, 0.0, kind + "_cells")
         rep = Show(src, view)
+        flat(rep)
         rep.ColorArrayName = ["POINTS", ""]
         rep.AmbientColor = rep.DiffuseColor = colour
         rep.LineWidth = width
@@ -426,8 +466,8 @@ def main():
                 fmax = max(fmax, rng[1])
         info["contacts"] = count(surf, t)
         info["contacts"]["max_abs_normal_force"] = fmax
-        if fmax > 0.0 and r_mean:
-            scale = TUBE * r_mean / fmax
+        if fmax > 0.0 and r_typical:
+            scale = TUBE * r_typical / fmax
             rad = Calculator(registrationName="tube_radius", Input=surf)
             rad.AttributeType = "Point Data"
             rad.ResultArrayName = "tube_radius"
@@ -460,9 +500,12 @@ def main():
                     lo, hi = min(lo, rng[0]), max(hi, rng[1])
         if lo <= hi:
             lut = GetColorTransferFunction(args.field)
-            lut.ApplyPreset("Cool to Warm", True)
-            if lo < 0.0 < hi:
+            if args.field.startswith(("stress", "pressure")):
+                # blue compression, red tension, white zero, whatever the range
+                lut.ApplyPreset("Cool to Warm", True)
                 lo, hi = -max(-lo, hi), max(-lo, hi)
+            else:
+                lut.ApplyPreset("Viridis (matplotlib)", True)
             if hi <= lo:
                 hi = lo + 1.0
             lut.RescaleTransferFunction(lo, hi)
@@ -499,6 +542,7 @@ def main():
     scale = 0.5 * max(h / usable[1], w / (usable[0] * aspect))
     cx = 0.5 * (box[0] + box[1]) + (scale * aspect * (1.0 - usable[0]) * 0.8 if bars else 0.0)
     cy = 0.5 * (box[2] + box[3]) + (scale * (1.0 - usable[1]) * 0.5 if not args.no_text else 0.0)
+    Render(view)            # paraview.simple resets the camera at the first render
     view.InteractionMode = "2D"
     view.CameraParallelProjection = 1
     view.CameraFocalPoint = [cx, cy, 0.0]
