@@ -14,7 +14,8 @@ It opens the series and shows, at the last snapshot (``--time T`` for another):
   rings, so that the elements stay visible;
 - the PCMM elements and the blocks as triangles coloured by ``FIELD`` (default
   ``stress_yy``, Pa, tension-positive; ``pressure`` where the model has fluids or
-  explosives), on a diverging scale symmetric about zero;
+  explosives), on a diverging scale symmetric about zero that covers the 1st to
+  99th percentile of the values;
 - the contacts as tubes whose radius is proportional to |normal force| (*Calculator*
   → *Threshold* |F_n| > 0 → *Extract Surface* → *Tube* varying its radius by that
   scalar), the largest ``TUBE`` × the median disc radius, coloured by ``normal_force``;
@@ -269,16 +270,46 @@ def options():
     return p.parse_args(sys.argv[1:] if AS_PROGRAM else [])
 
 
-def threshold(src, assoc, array, above, name):
-    """Cells whose ``array`` is >= ``above`` (ParaView 5.10+; ThresholdRange before)."""
+def threshold(src, assoc, array, value, name, below=False):
+    """Cells whose ``array`` is >= ``value`` (``below``: <= ``value``); ParaView 5.10+,
+    ThresholdRange before."""
     th = Threshold(registrationName=name, Input=src)
     th.Scalars = [assoc, array]
     try:
-        th.ThresholdMethod = "Above Upper Threshold"
-        th.UpperThreshold = above
+        th.ThresholdMethod = "Below Lower Threshold" if below else "Above Upper Threshold"
+        if below:
+            th.LowerThreshold = value
+        else:
+            th.UpperThreshold = value
     except AttributeError:
-        th.ThresholdRange = [above, 1e300]
+        th.ThresholdRange = [-1e300, value] if below else [value, 1e300]
     return th
+
+
+def disc_glyphs(src, disk, name, view, colour):
+    """A ``disk`` (radius 0.5) at every point of ``src``, scaled by its ``radius``
+    array x 2: a disc of the particle's radius."""
+    g = GlyphWithCustomSource(registrationName=name, Input=src, GlyphSource=disk)
+    g.ScaleArray = ["POINTS", "radius"]
+    g.ScaleFactor = 2.0
+    g.GlyphMode = "All Points"
+    g.OrientationArray = ["POINTS", "No orientation array"]
+    rep = Show(g, view)
+    flat(rep)
+    if DISC_FIELD:
+        ColorBy(rep, ("POINTS", DISC_FIELD))
+    else:
+        rep.ColorArrayName = ["POINTS", ""]
+        rep.AmbientColor = rep.DiffuseColor = colour
+    return g
+
+
+def union(a, b):
+    """The union of two bounds (None: empty)."""
+    if a is None or b is None:
+        return a if b is None else b
+    return [min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3]),
+            min(a[4], b[4]), max(a[5], b[5])]
 
 
 def bounds(src, t):
@@ -314,6 +345,23 @@ def median_radius(src, t):
     except Exception:   # no numpy in this ParaView: the middle of the range
         lo, hi = src.PointData["radius"].GetRange()
         return 0.5 * (lo + hi)
+
+
+def percentiles(src, where, name, t, q=(1.0, 99.0)):
+    """The ``q`` percentiles of a scalar array of ``src`` at time ``t``; None without
+    numpy or for a vector."""
+    try:
+        import numpy
+        from paraview import servermanager
+        from vtk.numpy_interface import dataset_adapter as dsa
+    except ImportError:
+        return None
+    src.UpdatePipeline(t)
+    data = dsa.WrapDataObject(servermanager.Fetch(src))
+    a = numpy.asarray((data.CellData if where == "CELLS" else data.PointData)[name])
+    if a.ndim != 1 or a.size == 0:
+        return None
+    return [float(v) for v in numpy.percentile(a, q)]
 
 
 def association(src, name, t):
@@ -356,6 +404,10 @@ def main():
         pass
     view.Background = [1.0, 1.0, 1.0]
     view.OrientationAxesVisibility = 0
+    try:
+        view.UseFXAA = 1          # smoother thin rings and lines
+    except AttributeError:
+        pass
 
     readers = {}
     for kind, name in SERIES.items():
@@ -399,37 +451,33 @@ def main():
         shown[kind] = src
         info[kind] = count(src, t)
 
-    # particles: discs at their true radius; rings over elements
-    discs = None
+    # particles: discs at their true radius; particles of PCMM elements as rings over
+    # them (their width set below, once the size of a pixel is known)
+    rings = ring_disk = None
+    r_typical = None
     if "particles" in readers:
         src = threshold(readers["particles"], "POINTS", "id", 0.0, "particles_valid")
-        ring = "elements" in readers
-        disk = Disk(registrationName="disc", InnerRadius=0.465 if ring else 0.0,
-                    OuterRadius=0.5, CircumferentialResolution=64, RadialResolution=1)
-        discs = GlyphWithCustomSource(registrationName="discs", Input=src, GlyphSource=disk)
-        discs.ScaleArray = ["POINTS", "radius"]
-        discs.ScaleFactor = 2.0            # the disk's radius is 0.5: diameter 1 x 2r
-        discs.GlyphMode = "All Points"
-        discs.OrientationArray = ["POINTS", "No orientation array"]
-        if ring:                          # just above the elements (z = 0.02 r)
-            discs.GlyphTransform.Translate = [0.0, 0.0, 0.01]
-        rep = Show(discs, view)
-        flat(rep)
-        if DISC_FIELD:
-            ColorBy(rep, ("POINTS", DISC_FIELD))
-        else:
-            rep.ColorArrayName = ["POINTS", ""]
-            rep.AmbientColor = rep.DiffuseColor = (
-                [0.3, 0.3, 0.3] if ring else [0.80, 0.80, 0.80])
-        shown["particles"] = discs
         info["particles"] = count(src, t)
-        info["discs"] = {"bounds": bounds(discs, t)}
         rr = array_range(src, "POINTS", "radius", t)
         info["particles"]["radius"] = rr
         r_typical = median_radius(src, t) if rr else None
         info["particles"]["median_radius"] = r_typical
-    else:
-        r_typical = None
+        free = src
+        if "elements" in readers and "elements" in src.PointData.keys():
+            bonded = threshold(src, "POINTS", "elements", 0.5, "particles_in_elements")
+            free = threshold(src, "POINTS", "elements", 0.5, "particles_free", below=True)
+            ring_disk = Disk(registrationName="ring", InnerRadius=0.46, OuterRadius=0.5,
+                             CircumferentialResolution=64, RadialResolution=1)
+            rings = disc_glyphs(bonded, ring_disk, "rings", view, [0.4, 0.4, 0.4])
+            rings.GlyphTransform.Translate = [0.0, 0.0, 0.01]   # over the elements
+            shown["rings"] = rings
+            info["particles"]["in_elements"] = count(bonded, t)["points"]
+        disk = Disk(registrationName="disc", InnerRadius=0.0, OuterRadius=0.5,
+                    CircumferentialResolution=64, RadialResolution=1)
+        discs = disc_glyphs(free, disk, "discs", view, [0.8, 0.8, 0.8])
+        discs.GlyphTransform.Translate = [0.0, 0.0, 0.01]
+        shown["particles"] = discs
+        info["discs"] = {"bounds": union(bounds(discs, t), bounds(rings, t) if rings else None)}
 
     # walls and couplings: lines
     for kind, width, colour in (("walls", 4.0, [0.1, 0.1, 0.1]),
@@ -490,15 +538,21 @@ def main():
             info["contacts"]["tube_scale"] = scale
             shown["contacts"] = tubes
 
-    # one scale for the field over elements and blocks (symmetric about 0 if it changes sign)
+    # one scale for the field over elements and blocks: its 1st to 99th percentile (a
+    # stress concentration at a corner does not wash out the rest), symmetric about 0
+    # for stresses and pressures
     if field_srcs:
         lo, hi = math.inf, -math.inf
+        full = [math.inf, -math.inf]
         for ft in frame_times:
             for src, where in field_srcs:
                 rng = array_range(src, where, args.field, ft)
                 if rng:
+                    full = [min(full[0], rng[0]), max(full[1], rng[1])]
+                    rng = percentiles(src, where, args.field, ft) or rng
                     lo, hi = min(lo, rng[0]), max(hi, rng[1])
         if lo <= hi:
+            info["field_full_range"] = full
             lut = GetColorTransferFunction(args.field)
             if args.field.startswith(("stress", "pressure")):
                 # blue compression, red tension, white zero, whatever the range
@@ -527,12 +581,7 @@ def main():
     box = None
     for src in shown.values():
         for ft in frame_times:
-            b = bounds(src, ft)
-            if b is None:
-                continue
-            box = b if box is None else [min(box[0], b[0]), max(box[1], b[1]),
-                                         min(box[2], b[2]), max(box[3], b[3]),
-                                         min(box[4], b[4]), max(box[5], b[5])]
+            box = union(box, bounds(src, ft))
     if box is None:
         box = [-1.0, 1.0, -1.0, 1.0, 0.0, 0.0]
     w, h = max(box[1] - box[0], 1e-12), max(box[3] - box[2], 1e-12)
@@ -550,6 +599,14 @@ def main():
     view.CameraViewUp = [0.0, 1.0, 0.0]
     view.CameraParallelScale = scale
     info["camera"] = {"focal_point": [cx, cy], "parallel_scale": scale, "bounds": box}
+    if ring_disk is not None:
+        # rings about 1.2 pixels wide; none where a particle is under 3 pixels across
+        pixel = 2.0 * scale / args.size[1]
+        ring_disk.InnerRadius = min(0.485, max(0.3, 0.5 - 1.2 * pixel / (2.0 * r_typical)))
+        if r_typical < 1.5 * pixel:
+            Hide(rings, view)
+        info["rings"] = {"inner_radius": ring_disk.InnerRadius,
+                         "radius_pixels": r_typical / pixel}
 
     for k, bar in enumerate(BARS):
         bar.Position = [0.86, 0.55 - 0.42 * k]
