@@ -130,6 +130,24 @@ def write_view_script(directory, series=None, field=None, disc_field=None, title
     return path
 
 
+def script_settings(path):
+    """The settings (upper-case names assigned a literal) of a ``view.py``."""
+    import ast
+    out = {}
+    try:
+        tree = ast.parse(Path(path).read_text())
+    except (OSError, SyntaxError, ValueError):
+        return out
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and len(node.targets) == 1 and \
+                isinstance(node.targets[0], ast.Name) and node.targets[0].id.isupper():
+            try:
+                out[node.targets[0].id] = ast.literal_eval(node.value)
+            except ValueError:
+                pass
+    return out
+
+
 def pvpython():
     """The ``pvpython`` (or ``pvbatch``) on PATH, or None."""
     return shutil.which("pvpython") or shutil.which("pvbatch")
@@ -185,7 +203,8 @@ def main(argv=None):
         "no display: it saves DIR/view.png. Options after DIR go to view.py (--png FILE, "
         "--time T, --size W H, --field NAME, --frames, --info FILE).")
     p.add_argument("directory", metavar="DIR")
-    p.add_argument("--rewrite", action="store_true", help="write view.py even if it exists")
+    p.add_argument("--rewrite", action="store_true", help="write view.py even if it exists "
+                   "(keeping its FIELD unless --field is given)")
     p.add_argument("--field", default=None, help="colour field of elements and blocks "
                    "(default stress_yy)")
     ns, rest = p.parse_known_args(argv)
@@ -196,7 +215,9 @@ def main(argv=None):
     script = d / SCRIPT_NAME
     try:
         if ns.rewrite or not script.exists():
-            write_view_script(d, field=ns.field)
+            field = ns.field or (script_settings(script).get("FIELD") if script.exists()
+                                 else None)
+            write_view_script(d, field=field)
             print(f"wrote {script}")
     except InputError as e:
         print(f"tdem view: {e}", file=sys.stderr)
@@ -578,8 +599,10 @@ def main():
         crep.Color = [0.0, 0.0, 0.0]
 
     # the camera: looking down z onto the union of what is shown, a margin around it
+    # (the bodies: particles, elements, blocks; walls may reach far beyond them)
     box = None
-    for src in shown.values():
+    bodies = [v for k, v in shown.items() if k in ("particles", "rings", "elements", "blocks")]
+    for src in bodies or list(shown.values()):
         for ft in frame_times:
             box = union(box, bounds(src, ft))
     if box is None:
@@ -600,10 +623,10 @@ def main():
     view.CameraParallelScale = scale
     info["camera"] = {"focal_point": [cx, cy], "parallel_scale": scale, "bounds": box}
     if ring_disk is not None:
-        # rings about 1.2 pixels wide; none where a particle is under 3 pixels across
+        # rings about 1.2 pixels wide; none where a particle is under 8 pixels across
         pixel = 2.0 * scale / args.size[1]
         ring_disk.InnerRadius = min(0.485, max(0.3, 0.5 - 1.2 * pixel / (2.0 * r_typical)))
-        if r_typical < 1.5 * pixel:
+        if r_typical < 4.0 * pixel:
             Hide(rings, view)
         info["rings"] = {"inner_radius": ring_disk.InnerRadius,
                          "radius_pixels": r_typical / pixel}

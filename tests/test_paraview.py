@@ -64,9 +64,9 @@ def test_view_script_is_written_with_the_series_and_arrays(lattice):
     assert s["TITLE"] == out.name and s["PNG"] == "view.png" and s["SIZE"] == [1600, 1200]
     assert s["TUBE"] == 0.25
     # discs at their radius: a disk of radius 0.5 scaled by radius x 2
-    assert 'OuterRadius=0.5' in text
-    assert 'discs.ScaleArray = ["POINTS", "radius"]' in text
-    assert "discs.ScaleFactor = 2.0" in text
+    assert text.count("OuterRadius=0.5") == 2                 # filled discs and rings
+    assert 'g.ScaleArray = ["POINTS", "radius"]' in text
+    assert "g.ScaleFactor = 2.0" in text
     # contacts: |normal force| > 0, Extract Surface, then Tube varying its radius
     chain = ['Function = "abs(normal_force)"', "ExtractSurface(", "Tube(",
              'VaryRadius = "By Absolute Scalar"']
@@ -165,8 +165,11 @@ def test_pvpython_draws_discs_at_their_radius_and_tubes(lattice, tmp_path):
             assert pixel((i + 0.5) * SPACING, (j + 0.5) * SPACING) == \
                 pytest.approx(white, abs=0.02)
     x, y = pos[-1]                         # the big disc: grey to 0.9 R, white at 1.15 R
-    assert pixel(x + 0.9 * BIG, y) == pytest.approx(grey, abs=0.02)
-    assert pixel(x + 1.15 * BIG, y) == pytest.approx(white, abs=0.02)
+    for sx in (1, -1):
+        assert pixel(x + sx * 0.9 * BIG, y) == pytest.approx(grey, abs=0.02)
+        assert pixel(x, y + sx * 0.9 * BIG) == pytest.approx(grey, abs=0.02)
+    assert pixel(x - 1.15 * BIG, y) == pytest.approx(white, abs=0.02)
+    assert pixel(x, y + 1.15 * BIG) == pytest.approx(white, abs=0.02)
     assert pixel(0.05, -0.99 * R).max() < 0.3          # the floor: a dark line
     assert pixel(SPACING, 0.5 * SPACING).max() < 0.9   # a contact tube: coloured, not grey
     # the share of drawn pixels: the discs' area over the frame's, plus the walls
@@ -175,7 +178,10 @@ def test_pvpython_draws_discs_at_their_radius_and_tubes(lattice, tmp_path):
     discs = math.pi * (9 * R ** 2 + BIG ** 2) - 12 * 2 * (R ** 2 * math.acos(SPACING / (2 * R))
                                                             - SPACING / 2 * math.sqrt(
                                                                 R ** 2 - SPACING ** 2 / 4))
-    walls_px = 4.0 * (0.09 + 0.09) / (2 * s) * H
+    # the walls (4 pixels wide) within the frame, which the bodies set
+    x0, x1, y0, y1 = fx - s * W / H, fx + s * W / H, fy - s, fy + s
+    inside = (min(x1, 0.06) - max(x0, -0.03)) + (min(y1, 0.06) - max(y0, -0.03))
+    walls_px = 4.0 * inside / (2 * s) * H
     expected = discs / frame + walls_px / (W * H)
     print(f"drawn {drawn:.4f}, expected {expected:.4f}")
     assert drawn == pytest.approx(expected, rel=0.05)
