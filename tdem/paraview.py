@@ -49,8 +49,9 @@ KINDS = ("elements", "blocks", "particles", "couplings", "walls", "contacts")
 DEFAULT_FIELD = "stress_yy"
 UNITS = {"stress": "Pa", "pressure": "Pa", "plastic_strain": "", "strain": "",
          "weight": "", "n_cover": "", "velocity": "m/s", "displacement": "m",
-         "normal_force": "N", "shear_force": "N", "radius": "m", "mass": "kg",
-         "omega": "rad/s", "force": "N", "torque": "N m", "failed": "", "elements": ""}
+         "normal_force": "N/m", "shear_force": "N/m", "radius": "m", "mass": "kg/m",
+         "omega": "rad/s", "force": "N/m", "torque": "N·m/m", "reaction": "N/m",
+         "failed": "", "elements": ""}
 
 
 def field_unit(name):
@@ -554,7 +555,7 @@ def main():
             lut.InvertTransferFunction()
             lut.RescaleTransferFunction(0.0, fmax)
             lut.AutomaticRescaleRangeMode = "Never"
-            colour_bar(view, lut, "normal force (N)", not args.no_text)
+            colour_bar(view, lut, "normal force (N/m)", not args.no_text)
             info["contacts"]["tube_bounds"] = bounds(tubes, t)
             info["contacts"]["tube_scale"] = scale
             shown["contacts"] = tubes

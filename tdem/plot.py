@@ -2,16 +2,17 @@
 
     fig = tdem.plot_history(sim)                         # or "out/pile/monitors.h5"
     fig = tdem.plot_history("out/pile", names=["floor_force"], out="floor.png",
-                            units={"floor_force": "N"})
+                            units={"floor_force": "kN/m"})
 
 Monitors of the same unit share a panel, each a line labelled with its name (a vector
 monitor one line per component, ``name[k]``); the y axis names the quantity and its
 unit, the x axis is the simulated time in seconds. The unit of a monitor comes from
 ``units`` ({name: unit}), else from a unit written in its name (``"load [N]"``,
 ``"load (kN)"``), else from the words of its name (:func:`monitor_unit`:
-``floor_force`` → N, ``sigma_v`` → Pa, ``kinetic_energy`` → J, ``top_uy`` → m);
+``floor_force`` → N/m, ``sigma_v`` → Pa, ``kinetic_energy`` → J/m, ``top_uy`` → m);
 a monitor whose unit is not known gets a panel of its own with its name on the axis.
-SI units as everywhere in tdem: in 2D forces and energies are per metre of thickness.
+SI units as everywhere in tdem: forces, energies, moments and masses are per metre of
+thickness (N/m, J/m, N·m/m, kg/m).
 """
 import re
 from pathlib import Path
@@ -28,10 +29,10 @@ _WORDS = (
           "evol", "damage"}),
     ("Pa", {"stress", "stresses", "sigma", "pressure", "sxx", "syy", "sxy", "szz", "tau",
             "modulus", "young", "kpa", "mpa", "cohesion"}),
-    ("N·m", {"moment", "torque", "couple"}),
-    ("N", {"force", "forces", "fx", "fy", "fz", "fn", "fs", "load", "loads", "reaction",
+    ("N·m/m", {"moment", "torque", "couple"}),
+    ("N/m", {"force", "forces", "fx", "fy", "fz", "fn", "fs", "load", "loads", "reaction",
            "reactions", "thrust", "drag", "weight"}),
-    ("J", {"energy", "kinetic", "potential", "gravitational", "dissipated", "work",
+    ("J/m", {"energy", "kinetic", "potential", "gravitational", "dissipated", "work",
            "elastic", "ek", "ep"}),
     ("rad/s", {"omega", "spin"}),
     ("m/s", {"velocity", "velocities", "speed", "vx", "vy", "vz", "v"}),
@@ -39,13 +40,13 @@ _WORDS = (
            "depth", "gap", "overlap", "settlement", "ux", "uy", "uz", "x", "y", "z",
            "elevation", "radius", "penetration"}),
     ("s", {"time", "period", "duration"}),
-    ("kg", {"mass"}),
+    ("kg/m", {"mass"}),
     ("deg", {"angle", "phi", "theta", "rotation"}),
 )
 
-QUANTITY = {"Pa": "stress", "N": "force", "N·m": "moment", "J": "energy",
+QUANTITY = {"Pa": "stress", "N/m": "force", "N·m/m": "moment", "J/m": "energy",
             "m/s": "velocity", "rad/s": "angular velocity", "m": "length", "s": "time",
-            "kg": "mass", "deg": "angle", "": "ratio"}
+            "kg/m": "mass", "deg": "angle", "": "ratio"}
 
 _UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\[\]()]*?)\s*[\])]\s*$")
 
@@ -53,7 +54,7 @@ _UNIT_IN_NAME = re.compile(r"[\[(]\s*([^\[\]()]*?)\s*[\])]\s*$")
 def monitor_unit(name):
     """The unit of a monitor from its name: a unit in brackets at its end (``"load
     [kN]"`` → ``"kN"``), else the first of its words (split at ``_``, spaces and
-    punctuation, case ignored) with a known unit (``"floor_force"`` → ``"N"``,
+    punctuation, case ignored) with a known unit (``"floor_force"`` → ``"N/m"``,
     ``"sigma_v"`` → ``"Pa"``, ``"F_H_over_F_V"`` → ``""``, a ratio). None when
     nothing is known."""
     name = str(name)
@@ -89,7 +90,8 @@ def _label(unit):
         return None
     q = QUANTITY.get(unit)
     if q is None:   # a unit written by the user: its usual quantity where known
-        q = {"kN": "force", "MN": "force", "kPa": "stress", "MPa": "stress",
+        q = {"N": "force", "kN": "force", "MN": "force", "kN/m": "force", "J": "energy",
+             "kPa": "stress", "MPa": "stress",
              "GPa": "stress", "mm": "length", "cm": "length", "km": "length",
              "kJ": "energy", "MJ": "energy", "ms": "time"}.get(unit, "value")
     return f"{q} ({unit})" if unit else f"{q} (–)"

@@ -27,8 +27,8 @@ def pile(tmp_path_factory):
 
 
 def test_monitor_units_from_names():
-    table = {"floor_force": "N", "blade_Fx": "N", "wall_loads": "N", "sigma_v": "Pa",
-             "plate_stress": "Pa", "P4 pressure": "Pa", "kinetic_energy": "J",
+    table = {"floor_force": "N/m", "blade_Fx": "N/m", "wall_loads": "N/m", "sigma_v": "Pa",
+             "plate_stress": "Pa", "P4 pressure": "Pa", "kinetic_energy": "J/m",
              "top_uy": "m", "shear0_width": "m", "mean_speed": "m/s", "F_H_over_F_V": "",
              "axial_strain": "", "load [kN]": "kN", "x (mm)": "mm", "omega_3": "rad/s",
              "count": None, "P1": None}
@@ -47,7 +47,7 @@ def test_lines_equal_the_recorded_histories(pile, tmp_path):
     labels = [[ln.get_label() for ln in ax.lines] for ax in axes]
     assert labels == [["floor_force", "wall_force_xy[0]", "wall_force_xy[1]"],
                       ["kinetic_energy"], ["mean_speed"], ["count"]]
-    assert [ax.get_ylabel() for ax in axes] == ["force (N)", "energy (J)",
+    assert [ax.get_ylabel() for ax in axes] == ["force (N/m)", "energy (J/m)",
                                                 "velocity (m/s)", "count"]
     assert axes[-1].get_xlabel() == "time (s)"
     for ax in axes:
@@ -75,7 +75,7 @@ def test_from_the_file_names_units_and_panels(pile, tmp_path):
     # the folder (its monitors.h5) gives the same numbers as the simulation
     fig = tdem.plot_history(out, names=["kinetic_energy", "floor_force"], out=None,
                             units={"floor_force": "N"}, panels="monitor")
-    assert [ax.get_ylabel() for ax in fig.axes] == ["energy (J)", "force (N)"]
+    assert [ax.get_ylabel() for ax in fig.axes] == ["energy (J/m)", "force (N)"]
     for ax, name in zip(fig.axes, ["kinetic_energy", "floor_force"]):
         np.testing.assert_allclose(ax.lines[0].get_xdata(), hist[name][0], rtol=1e-15)
         np.testing.assert_allclose(ax.lines[0].get_ydata(), hist[name][1], rtol=1e-15)
