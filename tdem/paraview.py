@@ -30,11 +30,14 @@ The placeholder cell of an empty file (no walls, no contacts yet; see
 :mod:`tdem.io`) is removed by a *Threshold* on the file's index array, so that it
 neither shows nor moves the camera.
 """
+import contextlib
 import os
 import random
+import select
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 from .errors import InputError
@@ -155,43 +158,94 @@ def pvpython():
 
 
 def view_command(directory, args=()):
-    """The command that runs ``directory/view.py`` in pvpython: under ``xvfb-run -a``
-    when there is no X display and xvfb-run is installed. None without pvpython."""
+    """``[pvpython, DIR/view.py, *args]``; None without pvpython."""
     exe = pvpython()
     if exe is None:
         return None
-    cmd = [exe, str(Path(directory) / SCRIPT_NAME), *map(str, args)]
-    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY") \
-            and shutil.which("xvfb-run"):
-        # -a: the first free display from -n on; a random start keeps two renders
-        # started at the same moment off the same display
-        cmd = ["xvfb-run", "-a", "-n", str(random.randint(100, 9999)), *cmd]
-    return cmd
+    return [exe, str(Path(directory) / SCRIPT_NAME), *map(str, args)]
+
+
+def _headless():
+    return not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
+
+
+@contextlib.contextmanager
+def _virtual_display(wait=30.0):
+    """An Xvfb server on a display it picks itself (``-displayfd``: no race with other
+    servers starting at the same moment); yields its name, ``":N"``."""
+    r, w = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(w), "-screen", "0", "2048x2048x24",
+                             "-nolisten", "tcp"], pass_fds=(w,),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(w)
+    try:
+        text = b""
+        end = time.monotonic() + wait
+        while not text.endswith(b"\n"):
+            ready, _, _ = select.select([r], [], [], max(0.0, end - time.monotonic()))
+            chunk = os.read(r, 64) if ready else b""
+            if not chunk:
+                raise RuntimeError("Xvfb did not start (no display number)")
+            text += chunk
+        yield ":" + text.decode().strip()
+    finally:
+        os.close(r)
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
 
 
 def _x_failed(proc):
+    """pvpython stopped because it had no usable X display."""
     return proc.returncode != 0 and any(
         k in (proc.stderr or "") for k in ("bad X server connection", "Xvfb failed",
-                                           "cannot open display"))
+                                           "cannot open display", "Xvfb did not start",
+                                           "XOpenGLRenderWindow"))
 
 
-def render(directory, args=(), timeout=600, write=True, **kw):
-    """Run ``directory/view.py`` in pvpython (headless where needed) with the script's
-    options ``args`` (e.g. ``["--png", "a.png", "--time", "0.5"]``); ``write``: write
-    the script first if it is missing (keywords as :func:`write_view_script`).
-    Returns the completed process; raises RuntimeError without pvpython."""
-    directory = Path(directory)
-    if write and not (directory / SCRIPT_NAME).exists():
-        write_view_script(directory, **kw)
+def _run_once(cmd, timeout, capture):
+    out = subprocess.PIPE if capture else None
+    if _headless() and shutil.which("Xvfb"):
+        try:
+            with _virtual_display() as display:
+                env = dict(os.environ, DISPLAY=display)
+                return subprocess.run(cmd, stdout=out, stderr=subprocess.PIPE, text=True,
+                                      timeout=timeout, env=env)
+        except RuntimeError as e:
+            return subprocess.CompletedProcess(cmd, 1, "" if capture else None, str(e))
+    if _headless() and shutil.which("xvfb-run"):
+        cmd = ["xvfb-run", "-a", "-n", str(random.randint(100, 9999)), *cmd]
+    return subprocess.run(cmd, stdout=out, stderr=subprocess.PIPE, text=True, timeout=timeout)
+
+
+def run_view(directory, args=(), timeout=600, capture=True, attempts=3):
+    """Run ``directory/view.py`` in pvpython with the script's options ``args``: with
+    no display, on a virtual one (Xvfb, else ``xvfb-run -a``), tried again up to
+    ``attempts`` times if pvpython could not open it. Returns the completed process
+    (stderr always captured, stdout if ``capture``); RuntimeError without pvpython."""
     cmd = view_command(directory, args)
     if cmd is None:
         raise RuntimeError("pvpython is not on PATH: install ParaView (e.g. apt-get "
                            "install paraview xvfb) to render the pictures")
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-    if _x_failed(proc):        # the virtual display did not come up: once more
-        proc = subprocess.run(view_command(directory, args), capture_output=True, text=True,
-                              timeout=timeout)
+    for _ in range(max(1, int(attempts))):
+        proc = _run_once(cmd, timeout, capture)
+        if not _x_failed(proc):
+            break
     return proc
+
+
+def render(directory, args=(), timeout=600, write=True, **kw):
+    """Run ``directory/view.py`` in pvpython (headless where needed, see
+    :func:`run_view`) with the script's options ``args`` (e.g. ``["--png", "a.png",
+    "--time", "0.5"]``); ``write``: write the script first if it is missing (keywords as
+    :func:`write_view_script`). Returns the completed process (stdout, stderr)."""
+    directory = Path(directory)
+    if write and not (directory / SCRIPT_NAME).exists():
+        write_view_script(directory, **kw)
+    return run_view(directory, args, timeout=timeout)
 
 
 def main(argv=None):
@@ -200,8 +254,8 @@ def main(argv=None):
     import argparse
     p = argparse.ArgumentParser(
         prog="tdem view", description="Write DIR/view.py (a ParaView script for the "
-        "series in DIR) and run it in pvpython, headless under xvfb-run where there is "
-        "no display: it saves DIR/view.png. Options after DIR go to view.py (--png FILE, "
+        "series in DIR) and run it in pvpython, on a virtual display (Xvfb) where there "
+        "is none: it saves DIR/view.png. Options after DIR go to view.py (--png FILE, "
         "--time T, --size W H, --field NAME, --frames, --info FILE).")
     p.add_argument("directory", metavar="DIR")
     p.add_argument("--rewrite", action="store_true", help="write view.py even if it exists "
@@ -225,16 +279,14 @@ def main(argv=None):
         return 2
     if ns.field is not None:
         rest = ["--field", ns.field, *rest]
-    cmd = view_command(d, rest)
-    if cmd is None:
+    if view_command(d, rest) is None:
         print(f"pvpython is not on PATH. With ParaView installed: pvpython {script} "
               f"(headless: xvfb-run -a pvpython {script}), or open it in the GUI: "
               f"paraview --script={script}")
         return 1
-    print(" ".join(cmd), flush=True)
-    proc = subprocess.run(cmd, stderr=subprocess.PIPE, text=True)
-    if _x_failed(proc):
-        proc = subprocess.run(view_command(d, rest), stderr=subprocess.PIPE, text=True)
+    print(" ".join(view_command(d, rest)) + (" (on a virtual display)" if _headless()
+                                               else ""), flush=True)
+    proc = run_view(d, rest, timeout=None, capture=False)
     sys.stderr.write(proc.stderr or "")
     return proc.returncode
 
