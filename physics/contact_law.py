@@ -160,14 +160,22 @@ def history_width(laws, tdim=TANGENT_2D):
     return max(sum(w for _, w in history_columns(c, tdim).values()) for c in laws)
 
 
+# the columns after the rolling ones: a pair's overlap offset u0 (PCMM hand-over), then
+# for shaped particles the normal angle of the last step (a warm start) and the pair's
+# state (> 0: touching, its R*; −1: tracked, apart; 0: not tracked); a wall contact of
+# a shaped particle keeps its state (> 0: touching, its R*)
+PAIR_TAIL = ("u0", "normal_angle", "shape_state")
+WALL_TAIL = ("shape_state",)
+
+
 def pair_history_width(laws, tdim=TANGENT_2D):
-    """Width of a particle pair's history vector: law columns, rolling, u0."""
-    return history_width(laws, tdim) + len(ROLLING_COLUMNS) + 1
+    """Width of a particle pair's history vector: law columns, rolling, PAIR_TAIL."""
+    return history_width(laws, tdim) + len(ROLLING_COLUMNS) + len(PAIR_TAIL)
 
 
 def wall_history_width(laws, tdim=TANGENT_2D):
-    """Width of a particle–wall history vector: law columns, rolling."""
-    return history_width(laws, tdim) + len(ROLLING_COLUMNS)
+    """Width of a particle–wall history vector: law columns, rolling, WALL_TAIL."""
+    return history_width(laws, tdim) + len(ROLLING_COLUMNS) + len(WALL_TAIL)
 
 
 def table_width(laws):

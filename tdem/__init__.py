@@ -14,6 +14,7 @@ from physics.hertz_mindlin import HertzMindlin
 from physics.linear import LinearContact
 from physics.rolling import RollingResistance
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
+from physics.shapes import Superellipse
 
 from . import mesh, pack
 from .plot import plot_history
@@ -24,5 +25,5 @@ __version__ = "0.1.0"
 
 __all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "ContactLaw", "register_law",
            "LinearContact", "HertzMindlin",
-           "RollingResistance", "PointEdge", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
+           "RollingResistance", "PointEdge", "Superellipse", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history"]

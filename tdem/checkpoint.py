@@ -39,9 +39,9 @@ from .errors import InputError
 from .step import W_LAW, WALL_WIDTH
 
 FORMAT = "tdem-checkpoint"
-VERSION = 1
+VERSION = 2     # 2: particle shapes and angles; two more history columns
 _FIX_NAMES = ("vx", "vy", "omega")
-_HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat")
+_HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle")
 
 
 def _config(sim):
@@ -284,10 +284,33 @@ def _read(path):
             g = r.node(key, fg)
             fixes.append((r.array("ids", g), *[r.array(nm, g) if r.has(nm, g) else None
                                                for nm in _FIX_NAMES]))
+    if version < 2:
+        _upgrade_v1(state, host)
     raw = dict(cfg=cfg, state=state, host=host, blocks=blocks, cstate=cstate, nonref=nonref,
                fixes=fixes)
     _check(r, raw)
     return raw
+
+
+def _upgrade_v1(state, host):
+    """A version-1 checkpoint (discs only): the particles get angle 0 and the disc shape,
+    the histories the shape columns (zeros: not tracked)."""
+    from physics import contact_law as cl
+    if "radius" in host:
+        n = len(host["radius"])
+        host.setdefault("shape", np.zeros((n, 4)))
+        host.setdefault("angle", np.zeros(n))
+    if "pos" in state:
+        n = len(state["pos"])
+        state.setdefault("angle", np.zeros(n))
+        state.setdefault("shp", np.zeros((n, 4)))
+    for k, tail in (("hist", 4), ("whist", 3)):
+        if k in state:
+            h = state[k]
+            if k == "hist" and h.shape[-1] == 4:      # written before u0 existed
+                h = cl.remap_history(h, 5, tail=4)
+            new = len(cl.PAIR_TAIL if k == "hist" else cl.WALL_TAIL) + 3 - tail
+            state[k] = np.concatenate([h, np.zeros(h.shape[:-1] + (new,), h.dtype)], axis=-1)
 
 
 def _first_bad(a):

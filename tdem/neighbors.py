@@ -39,6 +39,7 @@ F_NEED = 1       # largest number of slots any particle needed (half or reverse 
 F_WALL_NEED = 2  # largest number of wall slots any particle needed
 F_BAD = 3        # smallest index of an unstable particle (n if none)
 F_BUILDS = 4     # number of list builds so far
+F_NONCONV = 5    # shaped-particle contact evaluations whose iteration stopped short
 FLAGS_SIZE = 8
 
 

@@ -28,7 +28,7 @@ class Results:
         if self._n == 0:
             z2 = np.zeros((0, 2))
             z = np.zeros(0)
-            out = {"position": z2, "velocity": z2, "omega": z, "radius": z, "mass": z,
+            out = {"position": z2, "velocity": z2, "omega": z, "angle": z, "radius": z, "mass": z,
                    "force": z2, "torque": z, "displacement": z2}
             if stress:
                 out.update(stress=np.zeros((0, 2, 2)), stress_zz=z, pressure=z,
@@ -39,6 +39,7 @@ class Results:
         pos = a["pos"].to_numpy()
         out = {
             "position": pos, "velocity": a["vel"].to_numpy(), "omega": a["omega"].to_numpy(),
+            "angle": np.degrees(a["angle"].to_numpy()),
             "radius": prop[:, 0].copy(), "mass": prop[:, 1].copy(),
             "force": a["force"].to_numpy(), "torque": a["torque"].to_numpy(),
             "displacement": pos - a["pos0"].to_numpy(),

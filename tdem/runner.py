@@ -27,6 +27,7 @@ import numpy as np
 import taichi as ti
 
 from physics import contact_law as _claw
+from physics.shapes import mass_properties
 
 from . import backend, neighbors
 from . import state as schema
@@ -49,6 +50,14 @@ ANNOUNCE_MEASURE = 0.5
 class Runner:
     """Device state and the run loop of :class:`tdem.Simulation` (module docstring)."""
 
+
+    @property
+    def _has_shapes(self):
+        """Whether some particles are superellipses (the step kernel's ``shapes``)."""
+        chunks = self._host["shape"]
+        if self._shaped_cache is None or self._shaped_cache[0] != len(chunks):
+            self._shaped_cache = (len(chunks), any(bool((c[:, 2] > 0).any()) for c in chunks))
+        return self._shaped_cache[1]
 
     def _law_table(self):
         nl = max(len(self._laws), 1)
@@ -75,22 +84,24 @@ class Runner:
         vel = np.concatenate(self._host["vel"])
         r = np.concatenate(self._host["radius"])
         rho = np.concatenate(self._host["density"])
-        m = rho * np.pi * r ** 2
+        shape = np.concatenate(self._host["shape"])
+        m, inertia = mass_properties(shape, rho, r)
         if self._cont is not None and self._cont.has_pcmm:
             pm = self._cont.masses
+            inertia = np.where(np.isnan(pm), inertia, 0.5 * pm * r ** 2)
             m = np.where(np.isnan(pm), m, pm)
         n = len(r)
-        s = self._new_rows(pos, vel, r, m, np.concatenate(self._host["law"]), self._cap,
-                           self._capw)
+        s = self._new_rows(pos, vel, r, m, inertia, np.concatenate(self._host["law"]), shape,
+                           np.concatenate(self._host["angle"]), self._cap, self._capw)
         s["flags"] = np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32)
         return s
 
-    def _new_rows(self, pos, vel, r, m, law, cap, capw):
+    def _new_rows(self, pos, vel, r, m, inertia, law, shape, angle, cap, capw):
         """State rows of new particles (every saved per-particle and per-slot array)."""
         sizes = self._sizes(len(r), cap, capw, 1, 1, 1)
         return schema.fresh_rows(len(r), sizes, {
-            "pos": pos, "vel": vel, "pos0": pos, "xref": pos,
-            "prop": np.stack([r, m, 0.5 * m * r ** 2], axis=1),
+            "pos": pos, "vel": vel, "pos0": pos, "xref": pos, "shp": shape, "angle": angle,
+            "prop": np.stack([r, m, inertia], axis=1),
             "plaw": np.broadcast_to(np.asarray(law, np.int32), (len(r),))})
 
     def _build(self):
@@ -129,11 +140,11 @@ class Runner:
         """(Re)allocate every array for the current sizes and fill it from ``state``."""
         self._set_law_set(state)
         if new_particles is not None:
-            pos, vel, r, rho, law = new_particles
-            m = rho * np.pi * r ** 2
+            pos, vel, r, rho, law, shape, ang = new_particles
+            m, inertia = mass_properties(shape, rho, r)
             n = len(r)
-            add = self._new_rows(pos, vel, r, m, law, state["nbr"].shape[1],
-                                 state["wid"].shape[1])
+            add = self._new_rows(pos, vel, r, m, inertia, law, shape, ang,
+                                 state["nbr"].shape[1], state["wid"].shape[1])
             for k, v in add.items():
                 state[k] = np.concatenate([state[k], v])
             state["flags"][F_REBUILD] = 1
@@ -180,7 +191,9 @@ class Runner:
         for k, width in (("hist", _claw.pair_history_width(self._law_set)),
                          ("whist", _claw.wall_history_width(self._law_set))):
             if k in state:
-                state[k] = _claw.remap_history(state[k], width, tail=4 if k == "hist" else 3)
+                state[k] = _claw.remap_history(
+                    state[k], width, tail=3 + len(_claw.PAIR_TAIL if k == "hist" else
+                                                  _claw.WALL_TAIL))
 
     def _upload_laws(self):
         width = _claw.table_width(self._law_set)
@@ -320,9 +333,11 @@ class Runner:
 
     # ------------------------------------------------------------------ stepping
     def _step_args(self):
-        # the arrays by name; _one_step appends the last three (detail, continuum, laws)
+        # the arrays by name; _one_step appends the last four (detail, continuum, laws,
+        # shapes)
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
-                           detail=False, continuum=False, laws=self._law_set)[:-3]
+                           detail=False, continuum=False, laws=self._law_set,
+                           shapes=False)[:-4]
 
     def _xforce(self):
         if self._cont is not None:
@@ -387,7 +402,8 @@ class Runner:
             cont.point_edge(self, dt)
             cont.viscous_boundaries(self)
         if self._n:
-            stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set)
+            stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set,
+                       self._has_shapes)
         if cont is not None:
             cont.integrate(self)
         self._time += dt
@@ -525,7 +541,21 @@ class Runner:
                 bar.close()
         if self._output is not None:
             self._output.flush(self)
+        if self._has_shapes:
+            self._warn_nonconverged()
         return self
+
+    def _warn_nonconverged(self):
+        """Say when shaped-particle contacts stopped at the iteration cap (their normal
+        and depth are then those of the last iterate)."""
+        count = int(self._a["flags"].to_numpy()[neighbors.F_NONCONV])
+        if count > self._nonconv_reported:
+            warnings.warn(f"{count - self._nonconv_reported} contact evaluations of shaped "
+                          f"particles stopped at the iteration cap ({count} in all, "
+                          "sim.nonconverged_contacts): their normal is the last iterate's; "
+                          "a smaller time step or less overlap helps", RuntimeWarning,
+                          stacklevel=3)
+            self._nonconv_reported = count
 
     def _segment(self, target, bar):
         """Up to ``check_interval`` steps from a snapshot, then one look at the device."""

@@ -24,6 +24,7 @@ from physics import contact_law as _claw
 from physics.contact_law import ContactLaw
 from physics.linear import LinearContact
 from physics.materials import Material, MohrCoulomb
+from physics.shapes import Superellipse, mass_properties
 from physics import stability as _stability
 from physics.validate import in_range, indices, non_negative
 
@@ -35,7 +36,7 @@ from .errors import InputError
 from .handles import (Block, ParticleGroup, Wall, _View, _as_xy, _fix_value, _in_box,
                       _vector2)
 from .results import Results
-from .neighbors import F_BUILDS
+from .neighbors import F_BUILDS, F_NONCONV
 from .runner import MAX_SLOTS, Runner  # noqa: F401  (MAX_SLOTS: part of this module's names)
 
 # the engine's arrays are declared in tdem.state; the run loop is tdem.runner's, the
@@ -139,7 +140,10 @@ class Simulation(Runner, Results):
         self._law_set = _claw.registered()   # the law classes the kernels compile for
         self._pair_override = {}   # (law a, law b) -> law id
         self._groups = []
-        self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat")}
+        self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat", "shape",
+                                      "angle")}
+        self._shaped_cache = None
+        self._nonconv_reported = 0
         self._slots = []           # (material, tolerance) of PCMM bodies and blocks
         self._blocks = []
         self._cont = None          # Continuum (PCMM elements, blocks) once built
@@ -185,9 +189,15 @@ class Simulation(Runner, Results):
         self._laws.append(law)
         return len(self._laws) - 1
 
-    def add_particles(self, positions, radius, density=2500.0, contact=None, material=None,
-                      tolerance=0.0, velocity=None):
-        """Add discs; returns a :class:`ParticleGroup` (``.ids`` their indices).
+    def add_particles(self, positions, radius=None, density=2500.0, contact=None,
+                      material=None, tolerance=0.0, velocity=None, shape=None, angle=None):
+        """Add discs (``radius``) or shaped particles (``shape``, e.g.
+        :class:`tdem.Superellipse`, turned by ``angle``: degrees, counter-clockwise, a
+        number or one per particle; default 0); returns a :class:`ParticleGroup`
+        (``.ids`` their indices). A shape's bounding radius max(a, b) serves as the
+        particle's radius (neighbour search, output); its mass and inertia are the
+        shape's. Shaped particles take the linear or Hertz–Mindlin law (no rolling
+        resistance) and cannot be PCMM particles.
 
         With ``material`` (tdem.Elastic, MohrCoulomb, Fluid) the particles are PCMM
         particles of one continuum body: elements are created between particles of
@@ -198,6 +208,25 @@ class Simulation(Runner, Results):
         of thickness) and friction tan φ (MohrCoulomb) or 0.5.
         """
         slot = -1
+        if shape is not None:
+            if not isinstance(shape, Superellipse):
+                raise InputError(f"shape must be a shape such as tdem.Superellipse(a, b, n), got "
+                                 f"{shape!r}")
+            if radius is not None:
+                raise InputError(f"radius: a shaped particle's size is its shape's ({shape!r}); "
+                                 f"give radius or shape, not both (got radius={radius!r})")
+            if material is not None:
+                raise InputError(f"material: shaped particles cannot be PCMM particles (got "
+                                 f"shape={shape!r} with material={material!r})")
+            if contact is not None and getattr(contact, "rolling", None) is not None:
+                raise InputError(f"contact: rolling resistance is a disc feature; shaped "
+                                 f"particles take a law without rolling= (got {contact!r})")
+        elif radius is None:
+            raise InputError("radius must be given (one number or one per particle), or a "
+                             "shape= such as tdem.Superellipse(a, b, n)")
+        elif angle is not None:
+            raise InputError(f"angle: discs have no angle to set (got angle={angle!r}); it "
+                             "goes with shape=")
         if material is not None:
             if not isinstance(material, Material):
                 raise InputError("material must be a continuum material such as "
@@ -224,7 +253,18 @@ class Simulation(Runner, Results):
         n = len(pos)
         if n == 0:
             raise InputError("positions must hold at least one particle, got none")
-        r = _per_particle("radius", radius, n)
+        if shape is not None:
+            r = np.full(n, shape.bounding_radius)
+            shp = np.tile([shape.a, shape.b, shape.n, shape.area], (n, 1))
+            ang = np.radians(_per_particle("angle", 0.0 if angle is None else angle, n))
+            if not np.isfinite(ang).all():
+                k = int(np.argmax(~np.isfinite(ang)))
+                raise InputError(f"angle must be finite: particle {k} has angle "
+                                 f"{float(np.degrees(ang[k]))!r}")
+        else:
+            r = _per_particle("radius", radius, n)
+            shp = np.zeros((n, 4))
+            ang = np.zeros(n)
         bad = ~(np.isfinite(r) & (r > 0))
         if bad.any():
             k = int(np.argmax(bad))
@@ -242,7 +282,9 @@ class Simulation(Runner, Results):
             np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, 2)))
         _refuse_coincident(old, pos)
         if material is None:
-            _warn_overlaps(old, self._dem_radii(state), pos, r)
+            # (a shape's inscribed circle: a warning means a real overlap)
+            _warn_overlaps(old, self._dem_radii(state), pos,
+                           r if shape is None else np.full(n, shape.inscribed_radius))
         # every check passed: from here on the model changes (the law is checked
         # before it is added)
         law = self._law_id(contact)
@@ -255,11 +297,13 @@ class Simulation(Runner, Results):
         self._host["density"].append(rho)
         self._host["law"].append(np.full(n, law))
         self._host["mat"].append(np.full(n, slot))
+        self._host["shape"].append(shp)
+        self._host["angle"].append(ang)
         self._n += n
         g = ParticleGroup(self, ids, contact, rho)
         self._groups.append(g)
         if state is not None:
-            self._rebuild_from(state, new_particles=(pos, vel, r, rho, law))
+            self._rebuild_from(state, new_particles=(pos, vel, r, rho, law, shp, ang))
         return g
 
     def _dem_radii(self, state):
@@ -270,6 +314,9 @@ class Simulation(Runner, Results):
         r = state["prop"][:, 0].copy() if state is not None else np.concatenate(
             self._host["radius"])
         r[np.concatenate(self._host["mat"]) >= 0] = np.nan
+        shp = np.concatenate(self._host["shape"])
+        shaped = shp[:, 2] > 0
+        r[shaped] = np.minimum(shp[shaped, 0], shp[shaped, 1])    # inscribed circles
         return r
 
     def _slot_of(self, material, tol):
@@ -643,17 +690,36 @@ class Simulation(Runner, Results):
                 return crit
             raise InputError("the critical time step needs particles: add some first")
         r, m, plaw = self._masses()
+        shaped = self._shaped_mask()
+        inertia = self._inertias() if shaped.any() else None
         for sel, law in self._laws_met(plaw):
             k = law.critical_stiffness(r[sel], m[sel])
             crit = min(crit, float(np.min(2.0 * np.sqrt(m[sel] / k))))
+            if inertia is not None and (sel & shaped).any():
+                # a shape also turns: 2·sqrt(I/(k r_b²)) (PHYSICS §7)
+                rot = sel & shaped
+                kr = law.critical_stiffness(r[rot], m[rot])
+                crit = min(crit, float(np.min(2.0 * np.sqrt(inertia[rot] / (kr * r[rot] ** 2)))))
         return crit
+
+    def _shaped_mask(self):
+        if not self._n:
+            return np.zeros(0, bool)
+        return np.concatenate(self._host["shape"])[:, 2] > 0
+
+    def _inertias(self):
+        if self._built:
+            return self._a["prop"].to_numpy()[:, 2]
+        return mass_properties(np.concatenate(self._host["shape"]),
+                               np.concatenate(self._host["density"]), self._radii())[1]
 
     def _masses(self):
         """(radius, mass, law group) of every particle, from the device once built."""
         r = self._radii()
         if self._built:
             return r, self._a["prop"].to_numpy()[:, 1], self._a["plaw"].to_numpy()
-        m = np.concatenate(self._host["density"]) * np.pi * r ** 2
+        m = mass_properties(np.concatenate(self._host["shape"]),
+                            np.concatenate(self._host["density"]), r)[0]
         return r, m, np.concatenate(self._host["law"])
 
     def _laws_met(self, plaw):
@@ -750,3 +816,10 @@ class Simulation(Runner, Results):
     def __repr__(self):
         return (f"Simulation({self._n} particles, {len(self._walls_host)} walls, "
                 f"t={self._time:.6g} s, step {self._steps}, arch={self.arch})")
+
+    @property
+    def nonconverged_contacts(self):
+        """How many contact evaluations of shaped particles (all steps so far) stopped at
+        the iteration cap before their normal converged (0 in a healthy run; a run that
+        has some warns at its end)."""
+        return int(self._a["flags"].to_numpy()[F_NONCONV]) if self._built and self._n else 0

@@ -17,6 +17,7 @@ import taichi as ti
 from physics.contact_law import (TANGENT_2D, history_width, law_energy, law_force,
                                  law_stiffness, zero_history)
 from physics.geometry import disc_disc, disc_segment
+from physics.geometry import superellipse as se
 from physics.geometry.frame import tangent_part, tangent_vector
 from physics.rolling import rolling_couple, rolling_energy
 
@@ -24,6 +25,7 @@ from .finite import any_non_finite, non_finite
 from .integrate import damped_leapfrog
 from .launch import cached
 from .neighbors import F_BAD, F_REBUILD, slot_bits
+from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
 # columns of the float parameter array ``simp``
@@ -110,7 +112,8 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                   prop: ti.template(), wall: ti.template(), wforce: ti.template(),
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
                   wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
-                  laws: ti.template()):
+                  laws: ti.template(), angle: ti.template(), shp: ti.template(),
+                  flags: ti.template(), shapes: ti.template()):
     """Contacts of particle i with its candidate walls (listed in its wall slots by the
     neighbour build). The wall is 'j', of infinite radius and mass. Returns
     (force on i, moment on i, dissipation, work done by the walls). The history holds
@@ -122,14 +125,44 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
     work = 0.0
     ftot = ti.Vector([0.0, 0.0])
     mtot = 0.0
+    shaped = False
+    if ti.static(shapes):
+        shaped = shp[i][2] > 0.0
     for s in range(wid.shape[1]):
         w = wid[i, s]
         if w < 0:
             break
         a = ti.Vector([wall[w, W_X0], wall[w, W_Y0]])
         b = ti.Vector([wall[w, W_X1], wall[w, W_Y1]])
-        d, d2 = disc_segment.overlap(xi, a, b, wall[w, W_INVLL])
-        if d2 < ri * ri:
+        d = ti.Vector([0.0, 0.0])
+        d2 = 0.0
+        if not shaped:
+            d, d2 = disc_segment.overlap(xi, a, b, wall[w, W_INVLL])
+        if ti.static(shapes) and shaped:
+            c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
+            touching, f, mi, n, fn, fs, u, xc, vw, h, d1 = shaped_wall(
+                xi, vel[i], omega[i], prop[i][PROP_MASS], angle[i], shape_of(shp[i], ri), ri,
+                a, b, wall[w, W_INVLL], ti.Vector([wall[w, W_VX], wall[w, W_VY]]),
+                wall[w, W_OMEGA], c, ti.cast(wall[w, W_LAW], ti.i32), whist[i, s], lawp,
+                flags, dt, laws)
+            whist[i, s] = h
+            if touching:
+                wcn[i, s] = n
+                wcf[i, s] = ti.Vector([f[0], f[1], mi, 0.0])
+                wcs[i, s] = ti.Vector([fn, fs, u])
+                diss += d1
+                work += f.dot(vw) * dt
+                ftot += f
+                mtot += mi
+                r = xc - c
+                ti.atomic_add(wforce[w][0], -f[0])
+                ti.atomic_add(wforce[w][1], -f[1])
+                ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]))
+                ti.atomic_add(wforce[w][3], 1.0)
+            elif wcs[i, s][2] > 0.0:
+                wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+                wcs[i, s] = ti.Vector([0.0, 0.0, u])
+        elif d2 < ri * ri:
             c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
             ww = wall[w, W_OMEGA]
             u, n, t, ai, xc, vw, vrel = disc_segment.kinematics(
@@ -187,7 +220,7 @@ def servo_velocity(wall: ti.template(), wforce: ti.template(), w, dt):
 @cached
 @ti.kernel
 def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
-         prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
+         angle: ti.types.ndarray(), shp: ti.types.ndarray(), prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
          vfix: ti.types.ndarray(), force: ti.types.ndarray(), torque: ti.types.ndarray(),
          xref: ti.types.ndarray(), facc: ti.types.ndarray(), eacc: ti.types.ndarray(),
          estate: ti.types.ndarray(),
@@ -200,7 +233,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
          serial: ti.template(), detail: ti.template(), continuum: ti.template(),
-         laws: ti.template()):
+         laws: ti.template(), shapes: ti.template()):
     """One step. ``detail`` (a compile-time switch) also stores what only output
     reads: per-contact normals, scalar forces and overlaps, particle forces, and
     the kinetic and gravitational energy at t_n. The host asks for it on the last
@@ -237,6 +270,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         wi = omega[i]
         pi = prop[i]
         li = plaw[i]
+        thi = 0.0
+        shi = ti.Vector([0.0, 0.0, 0.0])
+        ishaped = False
+        if ti.static(shapes):
+            thi = angle[i]
+            shi = shape_of(shp[i], pi[PROP_RADIUS])
+            ishaped = shp[i][2] > 0.0
         for k in range(ncnt[i]):
             fk = ti.Vector([0.0, 0.0])
             mk = 0.0
@@ -258,10 +298,18 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     h0 = hist[i, k]
                     h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
                     hist[i, k] = h0
-                fk, mk, mjk, dk = pair_contact(i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS],
-                                               li, pos, vel,
-                                               omega, prop, plaw, lawp, lawpair, nbr, hist, cn,
-                                               cs, dt, detail, laws)
+                shaped = False
+                if ti.static(shapes):
+                    shaped = ishaped or shp[nbr[i, k]][2] > 0.0
+                if ti.static(shapes) and shaped:
+                    fk, mk, mjk, dk = shaped_pair(
+                        i, k, xi, vi, wi, pi[PROP_MASS], li, thi, shi, pi[PROP_RADIUS], pos,
+                        vel, omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs,
+                        flags, dt, detail, laws)
+                else:
+                    fk, mk, mjk, dk = pair_contact(
+                        i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
+                        prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws)
             f += fk
             tq += mk
             diss += dk
@@ -275,7 +323,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if skip != 1:      # (a carried pair's share is not read, see 2.)
                     cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
         fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
-                                         whist, wcn, wcf, wcs, dt, laws)
+                                         whist, wcn, wcf, wcs, dt, laws, angle, shp, flags,
+                                         shapes)
         own = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw])
         if ti.static(serial):
             facc[i] += own
@@ -345,6 +394,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         vel[i] = v1
         omega[i] = w1
         pos[i] = x1
+        angle[i] += w1 * dt
         dx = x1 - xref[i]
         if dx.dot(dx) > half_skin2:
             flags[F_REBUILD] = 1
@@ -406,6 +456,8 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                        lawpair: ti.types.ndarray(), laws: ti.template()) -> ti.f64:
     """Energy stored in the springs of every contact (law and rolling)."""
     R = ti.static(history_width(laws))
+    ST = ti.static(R + 5)            # a shaped contact's state: its R* while touching
+    WST = ti.static(R + 3)
     total = 0.0
     for i in range(pos.shape[0]):
         ri = prop[i][PROP_RADIUS]
@@ -417,6 +469,8 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                 L = lawpair[plaw[i], plaw[j]]
                 h = hist[i, k]
                 reff = ri * rj / (ri + rj)
+                if h[ST] > 0.0:
+                    reff = h[ST]
                 kn = law_stiffness(laws, lawp, L, u, reff)
                 total += law_energy(laws, lawp, L, u, reff, h, TANGENT_2D) + rolling_energy(
                     lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
@@ -427,29 +481,43 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                 if u > 0.0:
                     h = whist[i, s]
                     L = ti.cast(wall[w, W_LAW], ti.i32)
-                    kn = law_stiffness(laws, lawp, L, u, ri)
-                    total += law_energy(laws, lawp, L, u, ri, h, TANGENT_2D) + rolling_energy(
+                    reff = ri
+                    if h[WST] > 0.0:
+                        reff = h[WST]
+                    kn = law_stiffness(laws, lawp, L, u, reff)
+                    total += law_energy(laws, lawp, L, u, reff, h, TANGENT_2D) + rolling_energy(
                         lawp, L, kn, h[R], 2.0 * ri)
     return total
 
 
 @ti.kernel
-def particle_stress(prop: ti.types.ndarray(), nbr: ti.types.ndarray(),
+def particle_stress(prop: ti.types.ndarray(), angle: ti.types.ndarray(),
+                    shp: ti.types.ndarray(), nbr: ti.types.ndarray(),
                     ncnt: ti.types.ndarray(), cn: ti.types.ndarray(), cf: ti.types.ndarray(),
                     cs: ti.types.ndarray(), rev: ti.types.ndarray(), rcnt: ti.types.ndarray(),
                     wid: ti.types.ndarray(), wcn: ti.types.ndarray(), wcf: ti.types.ndarray(),
                     wcs: ti.types.ndarray(), out: ti.types.ndarray()):
-    """Average stress of each disc, σ = (1/(π R²)) Σ_c sym(r_c ⊗ f_c), tension-positive."""
+    """Average stress of each particle, σ = (1/A) Σ_c sym(r_c ⊗ f_c), tension-positive,
+    r_c from the centre to the contact point (for a disc (R − u/2) n; for a shape its
+    support point towards the contact less u/2 along n), A the disc's or shape's area."""
     cap = nbr.shape[1]
     bits = slot_bits(cap)
     for i in range(prop.shape[0]):
         ri = prop[i][PROP_RADIUS]
+        si = shp[i]
+        shaped = si[2] > 0.0
+        ci = ti.cos(angle[i])
+        sni = ti.sin(angle[i])
+        area = ti.math.pi * ri * ri
+        if shaped:
+            area = si[3]
         s = ti.Matrix([[0.0, 0.0], [0.0, 0.0]])
         for k in range(ncnt[i]):
             u = cs[i, k][2]
             if u > 0.0:
                 c = cf[i, k]
-                s += (ri - 0.5 * u) * cn[i, k].outer_product(ti.Vector([c[0], c[1]]))
+                n = cn[i, k]
+                s += _arm(shaped, si, ci, sni, ri, n, u).outer_product(ti.Vector([c[0], c[1]]))
         for r in range(rcnt[i]):
             flat = rev[i, r]
             j = flat >> bits
@@ -457,14 +525,26 @@ def particle_stress(prop: ti.types.ndarray(), nbr: ti.types.ndarray(),
             u = cs[j, k][2]
             if u > 0.0:
                 c = cf[j, k]
-                # r = −(R_i − u/2) n, f = −f_owner
-                s += (ri - 0.5 * u) * cn[j, k].outer_product(ti.Vector([c[0], c[1]]))
+                # the normal from i is −n, the force on i −f_owner
+                s -= _arm(shaped, si, ci, sni, ri, -cn[j, k], u).outer_product(
+                    ti.Vector([c[0], c[1]]))
         for q in range(wid.shape[1]):
             if wid[i, q] >= 0 and wcs[i, q][2] > 0.0:
                 u = wcs[i, q][2]
                 c = wcf[i, q]
-                s += (ri - 0.5 * u) * wcn[i, q].outer_product(ti.Vector([c[0], c[1]]))
-        s = 0.5 * (s + s.transpose()) / (ti.math.pi * ri * ri)
+                s += _arm(shaped, si, ci, sni, ri, wcn[i, q], u).outer_product(
+                    ti.Vector([c[0], c[1]]))
+        s = 0.5 * (s + s.transpose()) / area
         out[i, 0] = s[0, 0]
         out[i, 1] = s[1, 1]
         out[i, 2] = s[0, 1]
+
+
+@ti.func
+def _arm(shaped, si, ci, sni, ri, n, u):
+    """From a particle's centre to its contact of normal n (outward) and overlap u."""
+    arm = (ri - 0.5 * u) * n
+    if shaped:
+        _, p = se.support(ti.Vector([si[0], si[1], si[2]]), ci, sni, n)
+        arm = p - 0.5 * u * n
+    return arm

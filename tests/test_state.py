@@ -143,7 +143,8 @@ def _all_arrays(sim):
 def test_history_columns_follow_the_registered_laws():
     from physics import contact_law as cl
     laws = cl.registered()
-    assert cl.history_width(laws) == 1 and cl.pair_history_width(laws) == 5
+    assert cl.history_width(laws) == 1 and cl.pair_history_width(laws) == 7
+    assert cl.wall_history_width(laws) == 5      # law, rolling (3), shape state
     h = np.arange(10.0).reshape(2, 5)
     wide = cl.remap_history(h, 7, tail=4)
     np.testing.assert_array_equal(wide[:, 0], h[:, 0])
