@@ -301,6 +301,21 @@ def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None):
             for s in confining for (m, d) in materials]
 
 
+SWEEP_INSTALL = 'pip install "tdem[sweep]"'
+
+
+def dask_distributed():
+    """(Client, LocalCluster) of ``distributed``, imported on first use: Dask is an
+    optional extra of tdem. ImportError naming the install command when it is missing."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError as e:
+        raise ImportError(f"the sweep runs on Dask (dask.distributed), which is not "
+                          f"installed: {SWEEP_INSTALL} (or pip install "
+                          f'"dask[distributed]") ({e})') from None
+    return Client, LocalCluster
+
+
 def run_sweep(tasks, scheduler=None, workers=2):
     """Run ``tasks`` on Dask and return their results in order.
 
@@ -308,8 +323,8 @@ def run_sweep(tasks, scheduler=None, workers=2):
     one per test (:func:`shear_task`), which receives its specimen's checkpoint from
     the scheduler, so workers need no shared disk. ``scheduler``: address of an
     existing cluster; None starts a ``distributed.LocalCluster`` of ``workers``
-    processes with one thread each."""
-    from distributed import Client, LocalCluster
+    processes with one thread each. Needs Dask (``pip install "tdem[sweep]"``)."""
+    Client, LocalCluster = dask_distributed()
     cluster = None
     if scheduler is None:
         cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
@@ -621,6 +636,11 @@ def main(argv=None):
     if not (args.confining > 0 and math.isfinite(args.confining)):
         raise InputError(f"confining must be a positive stress in Pa, got {args.confining!r}")
     if args.sweep:
+        try:
+            dask_distributed()
+        except ImportError as e:
+            print(f"biaxial --sweep: {e}", file=sys.stderr)
+            return 2
         return _main_sweep(args, out, cfg, clock)
     if args.delta is not None or args.model is not None:
         model = 1 if args.model is None else args.model

@@ -5,7 +5,8 @@ The public API (see docs/api.md): :class:`Simulation`, the contact laws
 :class:`ContactLaw` with :func:`register_law` for laws of one's own), the
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
-:class:`InputError`, :class:`InstabilityError`.
+:class:`InputError`, :class:`InstabilityError`; :func:`plot_history` plots monitor
+histories.
 """
 from coupling.point_edge import PointEdge
 from physics.contact_law import ContactLaw, register_law
@@ -16,6 +17,7 @@ from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 from physics.shapes import Superellipse
 
 from . import mesh, pack
+from .plot import plot_history
 from .errors import CapacityError, InputError, InstabilityError
 from .simulation import Block, ParticleGroup, Simulation, Wall
 
@@ -24,4 +26,4 @@ __version__ = "0.1.0"
 __all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "ContactLaw", "register_law",
            "LinearContact", "HertzMindlin",
            "RollingResistance", "PointEdge", "Superellipse", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
-           "InstabilityError", "CapacityError", "mesh", "pack"]
+           "InstabilityError", "CapacityError", "mesh", "pack", "plot_history"]

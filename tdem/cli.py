@@ -2,6 +2,7 @@
 
     tdem list
     tdem run CASE [--preset quick|paper] [--arch cpu|gpu] [--out DIR] [...]
+    tdem view DIR [--png FILE] [--time T] [...]   (a ParaView picture of an output folder)
 
 Everything after ``CASE`` goes to the case's own ``main(argv)`` unchanged.
 """
@@ -25,6 +26,9 @@ def _parser():
     run.add_argument("case", metavar="CASE")
     run.add_argument("args", nargs=argparse.REMAINDER,
                      help="options of the case (--preset, --arch, --out, ...)")
+    sub.add_parser("view", add_help=False,
+                   help="write DIR/view.py (ParaView) for an output folder and run it in "
+                        "pvpython, saving DIR/view.png: tdem view DIR [--png FILE] ...")
     return p
 
 
@@ -35,6 +39,9 @@ def main(argv=None):
     if not argv:
         p.print_help()
         return 2
+    if argv[0] == "view":
+        from .paraview import main as view_main
+        return view_main(argv[1:])
     cases = _cases()
     if argv[0] == "run" and (len(argv) == 1 or argv[1] in ("-h", "--help")):
         print("usage: tdem run CASE [--preset quick|paper] [--arch cpu|gpu] [--out DIR] "

@@ -474,7 +474,10 @@ class Output:
     ``walls_KKKKK.vtu``, ``contacts_KKKKK.vtu`` (K: snapshot number), the indices
     ``particles.pvd``, ``walls.pvd``, ``contacts.pvd``, ``monitors.h5`` and, after an
     interrupted or unstable run, ``last_good.h5`` (a checkpoint of the last good
-    state, see :func:`tdem.checkpoint.load`).
+    state, see :func:`tdem.checkpoint.load`), and ``view.py``, a ParaView script that
+    shows the series and saves a PNG (``pvpython view.py``, headless ``xvfb-run -a
+    pvpython view.py``; :mod:`tdem.paraview`; attribute ``view_script=False``: not
+    written after the first snapshot).
 
     ``monitors.h5`` is written while the run goes on, at most every
     ``flush_interval`` seconds of wall-clock time (attribute, default
@@ -522,6 +525,8 @@ class Output:
         self.flush_interval = MONITOR_FLUSH_SECONDS
         self._monitors_key = None        # the records last written to monitors.h5
         self._monitors_at = -math.inf    # and when (time.monotonic)
+        self.view_script = True          # write view.py, a ParaView script of the series
+        self._view_kinds = None          # the kinds of files view.py was written for
         if sim is not None and _has_bodies(sim):
             self._write_initial(sim)
 
@@ -611,6 +616,23 @@ class Output:
         for kind in self._names(0):
             write_pvd(self.directory / f"{kind}.pvd",
                       [(t, self._names(k)[kind]) for _, t, k in self._entries])
+        self._write_view()
+
+    def _write_view(self):
+        """``view.py``, the ParaView script of the series (:mod:`tdem.paraview`), when
+        it is not written yet or the kinds of files changed; a failure is a warning."""
+        if not self.view_script:
+            return
+        kinds = tuple(self._names(0))
+        if kinds == self._view_kinds:
+            return
+        from .paraview import write_view_script
+        try:
+            write_view_script(self.directory, series={k: f"{k}.pvd" for k in kinds},
+                              sim=self._sim)
+            self._view_kinds = kinds
+        except Exception as e:  # noqa: BLE001 - a picture script must not stop a run
+            warnings.warn(f"could not write {self.directory / 'view.py'}: {e!r}")
 
     def truncate(self, step):
         """The run was rewound to ``step``: forget (and delete) the snapshots written
@@ -691,51 +713,17 @@ class Output:
 
 # ------------------------------------------------------------------ plots
 def plot_histories(source, png_path, names=None, title=None):
-    """PNG of monitor histories, one panel per monitor, time (s) on the x axis.
+    """PNG of monitor histories, one panel per monitor, time (s) on the x axis, the
+    unit of each monitor on its axis where its name tells it
+    (:func:`tdem.plot.plot_history` with ``panels="monitor"``; that function, as
+    ``tdem.plot_history``, also puts monitors of one unit on one panel).
 
     ``source``: a Simulation (its :meth:`~tdem.Simulation.histories`), the path of a
     ``monitors.h5`` file, or a dict {name: (times, values)}. ``names`` selects and
     orders the monitors (default: all). Vector-valued monitors get one line per
     component. Returns ``png_path``.
     """
-    from matplotlib.figure import Figure
-
-    if hasattr(source, "histories"):
-        hist = source.histories()
-    elif isinstance(source, dict):
-        hist = source
-    else:
-        hist = read_monitors(source)
-    if names is None:
-        names = list(hist)
-    else:
-        missing = [n for n in names if n not in hist]
-        if missing:
-            raise InputError(f"names: no monitor called {missing[0]!r}; there are "
-                             f"{sorted(hist)}")
-    rows = max(len(names), 1)
-    fig = Figure(figsize=(7.0, 1.0 + 2.2 * rows))
-    axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
-    for ax, name in zip(axes, names):
-        t, v = hist[name]
-        t = np.asarray(t, dtype=float)
-        v = np.asarray(v, dtype=float).reshape(len(t), -1) if len(t) else np.zeros((0, 1))
-        if v.shape[1] == 1:
-            ax.plot(t, v[:, 0], lw=1.2)
-        else:
-            for c in range(v.shape[1]):
-                ax.plot(t, v[:, c], lw=1.2, label=f"[{c}]")
-            ax.legend(fontsize="small", loc="best")
-        ax.set_ylabel(name)
-        ax.grid(alpha=0.3)
-    if not names:
-        axes[0].text(0.5, 0.5, "no monitors", ha="center", va="center",
-                     transform=axes[0].transAxes)
-    axes[-1].set_xlabel("time (s)")
-    if title:
-        axes[0].set_title(title)
-    fig.tight_layout()
+    from .plot import plot_history
     png_path = str(png_path)
-    Path(png_path).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(png_path, dpi=120, format="png")
+    plot_history(source, names=names, out=png_path, title=title, panels="monitor")
     return png_path

@@ -39,6 +39,12 @@ from .neighbors import F_BAD, F_NEED, F_REBUILD, F_WALL_NEED, FLAGS_SIZE
 
 MAX_SLOTS = 1024
 _COMPILED = False          # a run with a progress bar has happened in this process
+# a run estimated to take longer than this (wall-clock seconds) says so on stderr:
+# its time step, its number of steps and the estimated time (progress=False: silent)
+ANNOUNCE_SECONDS = 30.0
+# wall-clock seconds of steps, after the first segment (which compiles), the rate
+# of the estimate is measured over
+ANNOUNCE_MEASURE = 0.5
 
 
 class Runner:
@@ -560,9 +566,12 @@ class Runner:
         bar = self._progress_bar(total)
         t_wall = _time.perf_counter()
         done_at_start = self._steps
+        watch = _LongRun(self, total, dt) if self.progress is not False and total > 0 else None
         try:
             while self._steps < target:
                 self._segment(target, bar)
+                if watch is not None and watch(self._steps - done_at_start, bar):
+                    watch = None
                 if bar is not None:
                     bar.update(self._steps - bar.n - done_at_start)
                     el = _time.perf_counter() - t_wall
@@ -709,3 +718,58 @@ class Runner:
         from tqdm.auto import tqdm
         return tqdm(total=total, unit="step", desc=f"tdem (dt {self._dt_run:.3g} s)",
                     leave=False)
+
+
+def _duration(seconds):
+    """'45 s', '3 min 20 s', '2 h 05 min'."""
+    seconds = max(0.0, float(seconds))
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{int(seconds // 60)} min {int(seconds % 60):02d} s"
+    return f"{int(seconds // 3600)} h {int(seconds % 3600 // 60):02d} min"
+
+
+class _LongRun:
+    """Says on stderr, once the rate of the steps is known, that a run will take long
+    (over :data:`ANNOUNCE_SECONDS`): its time step, its steps and the estimated wall
+    time. The rate is measured after the first segment (whose time includes compiling
+    the kernels) over at least :data:`ANNOUNCE_MEASURE` seconds."""
+
+    def __init__(self, runner, total, dt):
+        self.runner, self.total, self.dt = runner, int(total), float(dt)
+        self.until = float(runner._time) + self.total * self.dt
+        self.t_start = _time.perf_counter()
+        self.t0 = self.n0 = None
+
+    def __call__(self, done, bar=None):
+        """After a segment, ``done`` steps of the run made; True when nothing more is
+        to be said (announced, or short)."""
+        now = _time.perf_counter()
+        if done >= self.total:
+            return True
+        if self.t0 is None:
+            self.t0, self.n0 = now, done
+            return False
+        el = now - self.t0
+        if el < ANNOUNCE_MEASURE or done <= self.n0:
+            return False
+        rate = (done - self.n0) / el
+        left = (self.total - done) / rate
+        if now - self.t_start + left <= ANNOUNCE_SECONDS:
+            return True
+        self.announce(rate, now - self.t_start + left, bar)
+        return True
+
+    def message(self, rate, seconds):
+        return (f"tdem: a long run: {self.total} steps of dt = {self.dt:.6g} s "
+                f"({self.total * self.dt:.6g} s of simulated time, to t = {self.until:.6g} s), "
+                f"about {_duration(seconds)} of wall time at {rate:.4g} steps/s "
+                f"({self.runner._dofs()} particles and nodes)")
+
+    def announce(self, rate, seconds, bar=None):
+        text = self.message(rate, seconds)
+        if bar is not None:
+            bar.write(text, file=sys.stderr)
+        else:
+            print(text, file=sys.stderr, flush=True)

@@ -114,6 +114,7 @@ TINY = {"n": 120, "strain_rate": 2.0, "axial_strain": 0.03, "seed": 5}
 
 
 def test_dask_sweep_equals_serial_runs():
+    pytest.importorskip("distributed", reason='Dask is an extra: pip install "tdem[sweep]"')
     tasks = biaxial.sweep_tasks(dict(TINY, materials=[(0, 0.0), (1, 0.4)]),
                                 confining=(SIGMA,))
     assert len(tasks) == 2

@@ -24,6 +24,8 @@ def test_readme_example_runs(k, tmp_path):
     if "out/pile" in BLOCKS[k]:
         assert (tmp_path / "out/pile/particles.pvd").exists()
         assert (tmp_path / "out/pile/monitors.h5").exists()
+        assert (tmp_path / "out/pile/view.py").exists()
+        assert (tmp_path / "out/pile/history.png").read_bytes()[:4] == b"\x89PNG"
         check = ("import tdem; s = tdem.Simulation.load('out/pile/end.h5'); "
                  "print(s.n_particles, s.time)")
         back = subprocess.run([sys.executable, "-c", check], cwd=tmp_path,
