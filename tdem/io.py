@@ -153,6 +153,9 @@ def write_particles_vtu(sim, path, particles=None):
         "stress": st.reshape(n, 9),
         "pressure": np.asarray(p["pressure"], dtype=np.float64),
     }
+    if _has_shapes(sim):
+        # 1 for a shaped particle (drawn from the shapes file), 0 for a disc
+        point_data["shape"] = (np.concatenate(sim._host["shape"])[:, 2] > 0).astype(np.int64)
     for name in ("plastic_strain", "elements"):
         if name in p:
             point_data[name] = np.asarray(p[name], dtype=np.float64)

@@ -46,7 +46,7 @@ SCRIPT_NAME = "view.py"
 
 # the series a folder may hold, in drawing order, and the array whose value is >= 0
 # on every real cell (the placeholder of an empty file has -1 there)
-KINDS = ("elements", "blocks", "particles", "couplings", "walls", "contacts")
+KINDS = ("elements", "blocks", "shapes", "particles", "couplings", "walls", "contacts")
 
 # the default colour field of elements and blocks, and its unit
 DEFAULT_FIELD = "stress_yy"
@@ -322,7 +322,7 @@ except NameError:            # pasted into a Python shell: the current folder
 AS_PROGRAM = bool(sys.argv) and os.path.basename(sys.argv[0]) == "view.py"
 # the array that is >= 0 on every real cell of a file (-1 on the placeholder of an
 # empty one), and whether it is point or cell data
-VALID = {"particles": ("POINTS", "id"), "walls": ("CELLS", "id"),
+VALID = {"particles": ("POINTS", "id"), "walls": ("CELLS", "id"), "shapes": ("CELLS", "id"),
          "elements": ("CELLS", "owner"), "blocks": ("CELLS", "block"),
          "couplings": ("CELLS", "kind")}
 BARS = []          # the colour bars shown, top to bottom
@@ -525,6 +525,17 @@ def main():
         shown[kind] = src
         info[kind] = count(src, t)
 
+    # shaped particles (superellipses): their polygons, filled
+    if "shapes" in readers:
+        src = threshold(readers["shapes"], "CELLS", "id", 0.0, "shapes_cells")
+        rep = Show(src, view)
+        rep.SetRepresentationType("Surface With Edges")
+        flat(rep)
+        rep.AmbientColor = rep.DiffuseColor = [0.8, 0.8, 0.8]
+        rep.EdgeColor = [0.45, 0.45, 0.45]
+        shown["shapes"] = src
+        info["shapes"] = count(src, t)
+
     # particles: discs at their true radius; particles of PCMM elements as rings over
     # them (their width set below, once the size of a pixel is known)
     rings = ring_disk = None
@@ -537,6 +548,8 @@ def main():
         r_typical = median_radius(src, t) if rr else None
         info["particles"]["median_radius"] = r_typical
         free = src
+        if "shape" in src.PointData.keys():     # shaped particles are drawn as polygons
+            free = threshold(src, "POINTS", "shape", 0.5, "particles_discs", below=True)
         if "elements" in readers and "elements" in src.PointData.keys():
             bonded = threshold(src, "POINTS", "elements", 0.5, "particles_in_elements")
             free = threshold(src, "POINTS", "elements", 0.5, "particles_free", below=True)
@@ -654,7 +667,8 @@ def main():
     # the camera: looking down z onto the union of what is shown, a margin around it
     # (the bodies: particles, elements, blocks; walls may reach far beyond them)
     box = None
-    bodies = [v for k, v in shown.items() if k in ("particles", "rings", "elements", "blocks")]
+    bodies = [v for k, v in shown.items()
+              if k in ("particles", "rings", "elements", "blocks", "shapes")]
     for src in bodies or list(shown.values()):
         for ft in frame_times:
             box = union(box, bounds(src, ft))

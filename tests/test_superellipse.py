@@ -241,3 +241,29 @@ def test_box_tips_only_where_tan_exceeds_width_over_height(deg, tips):
         # it stays (sliding freely it would go 7.8 m): the shear spring's give and the
         # rocking of its single contact point let it creep by millimetres
         assert abs(sim.particles.numpy()["position"][0, 0]) < 5e-3
+
+
+def test_shapes_are_written_as_polygons_of_their_area(tmp_path):
+    import meshio
+    s = Superellipse(0.2, 0.1, 4)
+    sim = tdem.Simulation(gravity=(0.0, 0.0))
+    law = tdem.LinearContact(kn=KN)
+    sim.add_particles([[0.0, 0.0], [1.0, 0.3]], shape=s, angle=[0.0, 30.0], density=RHO,
+                      contact=law)
+    sim.add_particles([[3.0, 0.0]], 0.1, density=RHO, contact=law)
+    paths = sim.write_vtu(tmp_path / "snap.vtu")
+    m = meshio.read(next(p for p in paths if p.endswith("_shapes.vtu")))
+    poly = m.cells_dict["polygon"]
+    assert poly.shape == (2, 48)
+    assert m.cell_data_dict["id"]["polygon"].tolist() == [0, 1]
+    np.testing.assert_allclose(m.cell_data_dict["angle"]["polygon"], [0.0, 30.0], atol=1e-12)
+    for k in range(2):
+        x, y = m.points[poly[k], 0], m.points[poly[k], 1]
+        area = 0.5 * (x * np.roll(y, -1) - np.roll(x, -1) * y).sum()
+        assert area == pytest.approx(s.area, rel=0.01)      # 48 points on the boundary
+    # the second one is turned by 30°: its farthest point along 30° is at a
+    far = m.points[poly[1], :2] - [1.0, 0.3]
+    u = np.array([np.cos(np.radians(30)), np.sin(np.radians(30))])
+    assert (far @ u).max() == pytest.approx(s.a, rel=1e-3)
+    p = meshio.read(paths[0])
+    np.testing.assert_allclose(p.point_data["angle"], [0.0, 30.0, 0.0], atol=1e-12)
