@@ -1,8 +1,9 @@
 """Superellipse throughput beside the disc pack of ``pack2d.py``, same machine, one run.
 
 The bed: 20,000 superellipses n = 4, a = 2 mm, b = 1 mm (aspect 2) stacked in 100
-columns of 200 on a floor between two walls, turned by small random angles (±3°),
-settled under gravity with the disc pack's law (linear spring–dashpot, μ = 0.5,
+columns of 200 on a floor between two walls, side by side and on each other (centres
+2a and 2b apart less 0.1 %: every particle starts with its four face contacts),
+turned by small random angles (±0.3°), resting under gravity with the disc pack's law (linear spring–dashpot, μ = 0.5,
 e = 0.5, k_n from the peers' stiffness), Δt = 1e-5 s; 2,000 warm-up steps then N
 timed steps. Then the disc pack of ``pack2d.py`` (40,000 discs) in the same process.
 
@@ -28,10 +29,9 @@ def build(cols=100, rows=200, arch=None, threads=None, seed=0):
     import tdem
     a, b = 0.002, 0.001
     shape = tdem.Superellipse(a=a, b=b, n=4)
-    rb = shape.bounding_radius
-    dx, dy = 2 * rb + 1e-4, 2 * rb
-    x = (np.arange(cols) + 0.5) * dx
-    y = b + 2e-4 + np.arange(rows) * dy
+    dx, dy = 2 * a * 0.999, 2 * b * 0.999
+    x = a + np.arange(cols) * dx
+    y = b * 0.999 + np.arange(rows) * dy
     pos = np.stack(np.meshgrid(x, y), -1).reshape(-1, 2)
     rng = np.random.default_rng(seed)
     k3, m3 = pack2d.peer_kn()
@@ -40,9 +40,9 @@ def build(cols=100, rows=200, arch=None, threads=None, seed=0):
     law = tdem.LinearContact(kn=kn, ks=kn, friction=0.5, restitution=0.5)
     sim = tdem.Simulation(gravity=(0.0, -9.81), dt=1e-5, arch=arch, threads=threads,
                           skin=0.0004, check_interval=500, progress=False)
-    sim.add_particles(pos, shape=shape, angle=rng.uniform(-3.0, 3.0, len(pos)),
+    sim.add_particles(pos, shape=shape, angle=rng.uniform(-0.3, 0.3, len(pos)),
                       density=2500.0, contact=law)
-    width = cols * dx
+    width = (cols - 1) * dx + 2 * a * 0.999
     top = pos[:, 1].max() + 0.1
     sim.add_wall((0.0, top), (0.0, 0.0), contact=law)
     sim.add_wall((width, 0.0), (width, top), contact=law)

@@ -61,10 +61,11 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
     m_on_j = 0.0
     diss = 0.0
     u_out = -1.0
-    # quick reject along the centre line: h_i(d̂) + h_j(−d̂) < |d| means apart
+    # quick reject along the centre line: h_i(d̂) + h_j(−d̂) < |d| means apart (a pair
+    # that touched at the last step goes straight to its warm-started minimisation)
     dist = d.norm()
     apart = dist >= rbi + rbj
-    if not apart and dist > 0.0:
+    if not apart and dist > 0.0 and h[ST] <= 0.0:
         dh = d / dist
         hi, _ = se.support(shi, ti.cos(thi), ti.sin(thi), dh)
         hj, _ = se.support(shj, ti.cos(thj), ti.sin(thj), -dh)
@@ -78,8 +79,8 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
         phi0 = h[PHI]
         if not tracked:
             phi0 = ti.atan2(d[1], d[0])
-        delta, n, p_i, p_j, phi, ok = se.pair_depth(shi, thi, shj, thj, d, phi0, tracked,
-                                                    False)
+        delta, n, p_i, p_j, phi, ok, rho_i, rho_j = se.pair_depth(shi, thi, shj, thj, d,
+                                                                  phi0, tracked, False)
         if not ok:
             ti.atomic_add(flags[F_NONCONV], 1)
         u_out = delta
@@ -91,9 +92,10 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
             vn = vrel.dot(n)
             L = lawpair[li, plaw[j]]
             mj = pj[PROP_MASS]
-            rho_i = se.curvature_radius(shi, ti.cos(thi), ti.sin(thi), n, rbi)
-            rho_j = se.curvature_radius(shj, ti.cos(thj), ti.sin(thj), -n, rbj)
-            reff = rho_i * rho_j / (rho_i + rho_j)
+            # R* from the curvature radii, each capped at its body's bounding radius
+            ri_c = ti.math.clamp(rho_i, 1e-6 * rbi, rbi)
+            rj_c = ti.math.clamp(rho_j, 1e-6 * rbj, rbj)
+            reff = ri_c * rj_c / (ri_c + rj_c)
             fn_el, fn, ft, kn, cnd, d1, h = law_force(
                 laws, lawp, L, delta, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff,
                 dt, h)

@@ -76,8 +76,8 @@ def depth_kernel():
     @ti.kernel
     def k(si: ti.types.vector(3, ti.f64), ti_: ti.f64, sj: ti.types.vector(3, ti.f64),
           tj: ti.f64, d: ti.types.vector(2, ti.f64)) -> ti.types.vector(4, ti.f64):
-        f, u, pi, pj, phi, ok = se.pair_depth(si, ti_, sj, tj, d, ti.atan2(d[1], d[0]),
-                                              False, False)
+        f, u, pi, pj, phi, ok, _, _ = se.pair_depth(si, ti_, sj, tj, d,
+                                                    ti.atan2(d[1], d[0]), False, False)
         return ti.Vector([f, u[0], u[1], ti.cast(ok, ti.f64)])
 
     def depth(si, ti_, sj, tj, d):
@@ -122,6 +122,29 @@ def test_geometric_potential_method_agrees_at_small_overlaps(depth_kernel):
         assert f == pytest.approx(1e-4, rel=1e-6)
         assert abs(gp - f) < 1e-6
         assert np.degrees(np.arccos(min(1.0, n @ ngp))) < 0.1
+
+
+@pytest.mark.parametrize("s", SHAPES, ids=repr)
+def test_curvature_radius_is_the_turn_of_the_support_point(depth_kernel, s):
+    """ρ = t·dp/dφ (central difference of the numpy support point) and, for an ellipse,
+    a²b²/h³."""
+    from physics.geometry import superellipse as se
+
+    @ti.kernel
+    def rho(sh: ti.types.vector(3, ti.f64), phi: ti.f64) -> ti.f64:
+        _, _, r = se.support_curv(sh, 1.0, 0.0, ti.Vector([ti.cos(phi), ti.sin(phi)]))
+        return r
+
+    for phi in (0.3, 1.0, 2.2, 4.0):
+        eps = 1e-6
+        u = lambda a: np.array([math.cos(a), math.sin(a)])
+        dp = (s.support(u(phi + eps))[1] - s.support(u(phi - eps))[1]) / (2 * eps)
+        t = np.array([-math.sin(phi), math.cos(phi)])
+        assert rho(ti.Vector(s.row), phi) == pytest.approx(t @ dp, rel=1e-6)
+        if s.n == 2:
+            h = s.support(u(phi))[0]
+            assert rho(ti.Vector(s.row), phi) == pytest.approx((s.a * s.b) ** 2 / h ** 3,
+                                                               rel=1e-12)
 
 
 # ------------------------------------------------------------------ mechanics

@@ -14,11 +14,14 @@ normal n (i → j). f′(φ) = t·(P_i − P_j) with P_i = x_i + p_i(u), P_j = x
 and t = u rotated +90°, so the minimum is where the two support points face each
 other along u. For apart bodies min f = −(their gap), so the same minimum is tracked
 smoothly through the first touch. The 1-D minimisation is warm-started from the
-normal angle stored in the contact's history (a bracket grown from it in steps that
-double); a pair met for the first time is scanned at 16 angles first. Inside the
-bracket a safeguarded false position (Illinois) solves f′ = 0 to 1e-13 rad (f64) or
-1e-6 rad (f32); at most ``ITER_CAP`` evaluations, the pairs that stop short are
-counted (never silent).
+normal angle stored in the contact's history; a pair met for the first time is scanned
+at 16 angles first. Newton's method on f′ = 0 with the analytic f″ = ρ_i + ρ_j − f
+(ρ the curvature radii) is kept inside the bracket that the signs of f′ build up, with
+a bisection where a step would leave it or not halve f′ (Numerical Recipes' rtsafe: the
+flat sides of n > 2, where ρ → ∞, make f′ behave like a cube root there). It stops
+when the two support points face each other within 1e-12 × the bodies' size (f64;
+1e-7 in f32) or the step is below 1e-13 rad; at most ``ITER_CAP`` evaluations, the
+pairs that stop short are counted (never silent).
 
 **Contact point and force.** The force acts at the midpoint c of P_i and P_j (the
 disc convention: R − δ/2 from each centre for discs), so that the tangential force
@@ -41,15 +44,15 @@ from taichi.lang import impl
 
 from .frame import perp
 
-ITER_CAP = 60       # evaluations of f′ for one contact (bracket and solve together)
+ITER_CAP = 100      # evaluations of f′ for one contact (bracket and solve together)
 SCAN = 16           # angles of the first scan of a new pair
 
 
 @ti.func
 def _tol():
-    t = 1e-13
+    t = 1e-10
     if ti.static(impl.get_runtime().default_fp != ti.f64):
-        t = 1e-6
+        t = 1e-5
     return t
 
 
@@ -106,131 +109,167 @@ def support(shp, c, s, u):
 def curvature_radius(shp, c, s, u, cap):
     """Radius of curvature of the boundary at its point of outward normal u, capped
     at ``cap`` (module docstring)."""
-    a = shp[0]
-    b = shp[1]
-    rho = 0.0
-    if shp[2] == 2.0:
-        ub = rot(u, c, -s)
-        ax = a * ub[0]
-        by = b * ub[1]
-        h = ti.sqrt(ax * ax + by * by)
-        rho = (a * b) ** 2 / (h * h * h)
-    else:
-        eps = 1e-4
-        t = perp(u)
-        cp = ti.cos(eps)
-        sp = ti.sin(eps)
-        _, p1 = support(shp, c, s, cp * u + sp * t)
-        _, p0 = support(shp, c, s, cp * u - sp * t)
-        rho = t.dot(p1 - p0) / (2.0 * sp)
+    _, _, rho = support_curv(shp, c, s, u)
     return ti.math.clamp(rho, 1e-6 * cap, cap)
 
 
 @ti.func
-def _slope(si, ci, sni, sj, cj, snj, d, phi, point: ti.template()):
-    """(f(φ), f′(φ), u, p_i, p_j) of the pair function (module docstring); ``point``:
-    body j is a point (h_j = 0)."""
+def support_curv(shp, c, s, u):
+    """(h(u), p(u), ρ(u)): the support function, the support point (world frame, from
+    the centre) and the radius of curvature there, ρ = tᵀ∇²h t. For n = 2,
+    ρ = a²b²/h³; else, with A = |a u'_x|, B = |b u'_y|, S = A^q + B^q,
+    ρ = (q − 1) S^(1/q − 2) A^(q − 2) B^(q − 2) (B² a/b + A² b/a)² (from the Hessian of
+    h), infinite (returned as 1e30) on the flat points of n > 2 where A or B is 0."""
+    a = shp[0]
+    b = shp[1]
+    n = shp[2]
+    ub = rot(u, c, -s)
+    h = 0.0
+    pb = ti.Vector([0.0, 0.0])
+    rho = 1e30
+    if n == 2.0:
+        ax = a * ub[0]
+        by = b * ub[1]
+        h = ti.sqrt(ax * ax + by * by)
+        pb = ti.Vector([a * ax, b * by]) / h
+        rho = (a * b) ** 2 / (h * h * h)
+    else:
+        q = n / (n - 1.0)
+        A = ti.abs(a * ub[0])
+        B = ti.abs(b * ub[1])
+        m = ti.max(A, B)
+        rx = A / m
+        ry = B / m
+        sx = 0.0
+        sy = 0.0
+        if rx > 0.0:
+            sx = ti.pow(rx, q)
+        if ry > 0.0:
+            sy = ti.pow(ry, q)
+        ssum = sx + sy
+        h = m * ti.pow(ssum, 1.0 / q)
+        e = 1.0 / n
+        px = 0.0
+        py = 0.0
+        if sx > 0.0:
+            px = a * ti.math.sign(ub[0]) * ti.pow(sx / ssum, e)
+        if sy > 0.0:
+            py = b * ti.math.sign(ub[1]) * ti.pow(sy / ssum, e)
+        pb = ti.Vector([px, py])
+        if sx > 0.0 and sy > 0.0:
+            # A^(q−2) = A^q/A², S^(1/q−2) = h/S², A^q = s_x m^q, S = Σ m^q:
+            # ρ = (q − 1) h s_x s_y / Σ² · w² / (A² B²)
+            Ax = rx * m
+            By = ry * m
+            w = By * By * a / b + Ax * Ax * b / a
+            rho = (q - 1.0) * h * sx * sy / (ssum * ssum) * w * w / (Ax * Ax * By * By)
+    return h, rot(pb, c, s), rho
+
+
+@ti.func
+def _eval(si, ci, sni, sj, cj, snj, d, phi, point: ti.template()):
+    """(f, f′, f″, u, p_i, p_j, ρ_i, ρ_j) of the pair function at φ (module docstring):
+    f″ = ρ_i + ρ_j − f; ``point``: body j is a point (h_j = 0, ρ_j = 0)."""
     u = ti.Vector([ti.cos(phi), ti.sin(phi)])
-    hi, pi = support(si, ci, sni, u)
+    hi, pi, ri = support_curv(si, ci, sni, u)
     hj = 0.0
     pj = ti.Vector([0.0, 0.0])
+    rj = 0.0
     if ti.static(not point):
-        hj, pj = support(sj, cj, snj, -u)
+        hj, pj, rj = support_curv(sj, cj, snj, -u)
     f = hi + hj - u.dot(d)
     g = perp(u).dot(pi - pj - d)
-    return f, g, u, pi, pj
+    return f, g, ri + rj - f, u, pi, pj, ri, rj
+
+
+@ti.func
+def _value(si, ci, sni, sj, cj, snj, d, phi, point: ti.template()):
+    u = ti.Vector([ti.cos(phi), ti.sin(phi)])
+    hi, _ = support(si, ci, sni, u)
+    hj = 0.0
+    if ti.static(not point):
+        hj, _ = support(sj, cj, snj, -u)
+    return hi + hj - u.dot(d)
 
 
 @ti.func
 def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
     """Minimum of the pair function near φ0 (``warm``: the normal angle of the last
     step, else a scan of SCAN angles picks the start). ``si``/``sj`` the shapes, ``ti_``/
-    ``tj`` their angles, d = x_j − x_i. Returns (δ, n, p_i, p_j, φ, converged)."""
+    ``tj`` their angles, d = x_j − x_i. Newton's method on f′ = 0 with f″ = ρ_i + ρ_j − f,
+    kept inside the bracket [lo, hi] that the signs of f′ build up (a bisection where a
+    step would leave it or f″ ≤ 0), each step at most 0.3 rad. Returns (δ, n, p_i, p_j,
+    φ, converged, ρ_i, ρ_j)."""
     ci = ti.cos(ti_)
     sni = ti.sin(ti_)
     cj = ti.cos(tj)
     snj = ti.sin(tj)
     tol = _tol()
     phi = phi0
-    step = 1e-3
     if not warm:
         best = 1e300
         for k in range(SCAN):
             a = phi0 + 6.283185307179586 * k / SCAN
-            f, _, _, _, _ = _slope(si, ci, sni, sj, cj, snj, d, a, point)
-            if f < best:
-                best = f
+            fa = _value(si, ci, sni, sj, cj, snj, d, a, point)
+            if fa < best:
+                best = fa
                 phi = a
-        step = 6.283185307179586 / SCAN
-    # bracket: g(lo) < 0 < g(hi), grown from φ downhill
-    f, g, u, pi, pj = _slope(si, ci, sni, sj, cj, snj, d, phi, point)
-    lo = phi
-    hi = phi
-    glo = g
-    ghi = g
-    evals = 1
-    done = False
+    lo = -1e30
+    hi = 1e30
+    f, g, fpp, u, pi, pj, ri, rj = _eval(si, ci, sni, sj, cj, snj, d, phi, point)
     scale = ti.max(si[0], si[1])
     if ti.static(not point):
         scale += ti.max(sj[0], sj[1])
-    if ti.abs(g) <= tol * scale:
-        done = True
-    elif g < 0.0:
-        # the minimum lies at larger φ
-        while evals < ITER_CAP and ghi < 0.0:
-            lo = hi
-            glo = ghi
-            hi = lo + step
-            step *= 2.0
-            _, ghi, _, _, _ = _slope(si, ci, sni, sj, cj, snj, d, hi, point)
-            evals += 1
-    else:
-        while evals < ITER_CAP and glo > 0.0:
-            hi = lo
-            ghi = glo
-            lo = hi - step
-            step *= 2.0
-            _, glo, _, _, _ = _slope(si, ci, sni, sj, cj, snj, d, lo, point)
-            evals += 1
-    if not done:
-        # Illinois false position on g = 0 within [lo, hi]
-        side = 0
-        while evals < ITER_CAP and hi - lo > tol:
-            x = lo
-            if ghi != glo:
-                x = (lo * ghi - hi * glo) / (ghi - glo)
-            if not (lo < x < hi):
-                x = 0.5 * (lo + hi)
-            _, gx, _, _, _ = _slope(si, ci, sni, sj, cj, snj, d, x, point)
-            evals += 1
-            if gx == 0.0:
-                lo = x
-                hi = x
-            elif gx < 0.0:
-                lo = x
-                glo = gx
-                if side == -1:
-                    ghi *= 0.5
-                side = -1
-            else:
-                hi = x
-                ghi = gx
-                if side == 1:
-                    glo *= 0.5
-                side = 1
-        phi = 0.5 * (lo + hi)
-        f, g, u, pi, pj = _slope(si, ci, sni, sj, cj, snj, d, phi, point)
-        done = hi - lo <= tol
+    gtol = tol * 1e-2 * scale          # the support points face each other to this
+    done = ti.abs(g) <= gtol
+    dx = 0.3
+    dxold = 0.3
+    free = 0.01
+    it = 0
+    while it < ITER_CAP and not done:
+        it += 1
+        if g < 0.0:
+            lo = phi
+        else:
+            hi = phi
+        bracket = lo > -1e29 and hi < 1e29
+        new = phi
+        finite = fpp > 0.0 and fpp < 1e29
+        newton_ok = finite
+        if bracket and newton_ok:
+            newton_ok = ti.abs(2.0 * g) <= ti.abs(dxold * fpp)    # halves at least (rtsafe)
+        if bracket and (not newton_ok or not (lo < phi - g / fpp < hi)):
+            dxold = dx
+            dx = 0.5 * (hi - lo)
+            new = lo + dx
+        elif not bracket:
+            # downhill until f′ changes sign: Newton's step where it is one (clamped),
+            # else a step that doubles each time
+            step = -free * ti.math.sign(g)
+            free *= 2.0
+            if newton_ok and ti.abs(g) > 1e-6 * fpp * free:
+                step = ti.math.clamp(-g / fpp, -0.3, 0.3)
+            dxold = dx
+            dx = step
+            new = phi + step
+        else:
+            dxold = dx
+            dx = -g / fpp
+            new = phi + dx
+        phi = new
+        f, g, fpp, u, pi, pj, ri, rj = _eval(si, ci, sni, sj, cj, snj, d, phi, point)
+        if ti.abs(g) <= gtol or (bracket and ti.abs(dx) <= tol * 1e-3):
+            done = True
     # keep the stored angle in (−π, π]
     phi = ti.atan2(u[1], u[0])
-    return f, u, pi, pj, phi, done
+    return f, u, pi, pj, phi, done, ri, rj
 
 
 @ti.func
 def point_depth(s, th, xp, phi0):
     """Depth of the point x_p (relative to the centre) inside shape ``s`` turned by
     ``th``: the pair function with h_j = 0. Returns (δ, n, p, converged)."""
-    f, u, p, _, _, ok = pair_depth(s, th, s, 0.0, xp, phi0, False, True)
+    f, u, p, _, _, ok, _, _ = pair_depth(s, th, s, 0.0, xp, phi0, False, True)
     return f, u, p, ok
 
 
