@@ -247,7 +247,7 @@ def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
             # else a step that doubles each time
             step = -free * ti.math.sign(g)
             free *= 2.0
-            if newton_ok and ti.abs(g) > 1e-6 * fpp * free:
+            if newton_ok and ti.abs(g) > 1e-12 * fpp:
                 step = ti.math.clamp(-g / fpp, -0.3, 0.3)
             dxold = dx
             dx = step
