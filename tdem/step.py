@@ -138,7 +138,7 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         d2 = 0.0
         if not shaped:
             d, d2 = disc_segment.overlap(xi, a, b, wall[w, W_INVLL])
-        if ti.static(shapes) and shaped:
+        if shaped:       # (False, a constant, in a model without shapes)
             c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
             touching, f, mi, n, fn, fs, u, xc, vw, h, d1 = shaped_wall(
                 xi, vel[i], omega[i], prop[i][PROP_MASS], angle[i], shape_of(shp[i], ri), ri,
@@ -303,11 +303,17 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 shaped = False
                 if ti.static(shapes):
                     shaped = ishaped or shp[nbr[i, k]][2] > 0.0
-                if ti.static(shapes) and shaped:
-                    fk, mk, mjk, dk = shaped_pair(
-                        i, k, xi, vi, wi, pi[PROP_MASS], li, thi, shi, pi[PROP_RADIUS], pos,
-                        vel, omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs,
-                        flags, dt, detail, laws, per)
+                if ti.static(shapes):
+                    if shaped:
+                        fk, mk, mjk, dk = shaped_pair(
+                            i, k, xi, vi, wi, pi[PROP_MASS], li, thi, shi, pi[PROP_RADIUS],
+                            pos, vel, omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist,
+                            cn, cs, flags, dt, detail, laws, per)
+                    else:
+                        fk, mk, mjk, dk = pair_contact(
+                            i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel,
+                            omega, prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail,
+                            laws, per)
                 else:
                     fk, mk, mjk, dk = pair_contact(
                         i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
