@@ -332,8 +332,10 @@ def write_contacts_vtu(sim, path, particles=None):
     a = pos[pairs[:, 0]] if m else np.zeros((0, 2))
     b = np.zeros((m, 2))
     to_particle = pairs[:, 1] >= 0
-    # to j's image nearest to i (across a periodic boundary)
-    b[to_particle] = a[to_particle] + sim._image(pos[pairs[to_particle, 1]] - a[to_particle])
+    b[to_particle] = pos[pairs[to_particle, 1]]
+    if any(p is not None for p in getattr(sim, "_periodic", ())):
+        # to j's image nearest to i (across a periodic boundary)
+        b[to_particle] = a[to_particle] + sim._image(b[to_particle] - a[to_particle])
     b[~to_particle] = np.asarray(c["point"]).reshape(-1, 2)[~to_particle]
     pts = np.empty((2 * m, 2))
     pts[0::2] = a

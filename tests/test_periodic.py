@@ -154,3 +154,15 @@ def test_a_period_shorter_than_three_cells_is_refused():
                       contact=tdem.LinearContact(kn=KN))
     with pytest.raises(tdem.InputError, match="period 0.5 m must hold three cells"):
         sim.run(steps=1)
+
+
+def test_a_periodic_model_of_shapes_restarts_exactly_from_a_checkpoint(tmp_path):
+    sim, _ = _gas(True, steps=500)
+    sim.save(tmp_path / "gas.h5")
+    sim.run(steps=500)
+    again = tdem.Simulation.load(tmp_path / "gas.h5")
+    assert again._periodic == sim._periodic
+    again.run(steps=500)
+    a, b = sim.particles.numpy(), again.particles.numpy()
+    for k in ("position", "velocity", "omega", "angle", "displacement"):
+        np.testing.assert_array_equal(a[k], b[k])
