@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from cases import _common as common
 from tdem import cli
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -63,12 +64,17 @@ def test_nine_disc_quick(tmp_path):
     out = tmp_path / "nd"
     assert cli.main(["run", "nine_disc", "--preset", "quick", "--out", str(out)]) == 0
     s = _summary(out)
-    for fig in s["figures"].values():
-        assert {"value", "target", "unit", "note"} <= set(fig)
-    amp = s["figures"]["undamped_amplitude_over_F_eq"]["value"]
+    assert common.validate(s) == []
+    c = common.checks_by_name(s)
+    amp = c["undamped_amplitude_over_F_eq"]["value"]
     assert 0.02 <= amp <= 0.25   # C&S about 0.15; set by dt (cases.nine_disc docstring)
-    assert abs(s["figures"]["damped_final_over_F_eq_from_undamped_mean"]["value"] - 1) < 0.02
-    assert s["figures"]["fig7a_amplitude_ratio_fast_over_slow"]["value"] > 1
+    assert c["undamped_amplitude_over_F_eq"]["target"] == pytest.approx(0.15)
+    assert abs(c["damped_final_over_F_eq_from_undamped_mean"]["value"] - 1) < 0.02
+    assert c["damped_final_over_F_eq_from_undamped_mean"]["pass"] is True
+    assert c["fig7a_amplitude_ratio_fast_over_slow"]["value"] > 1
+    # the closed forms of the module docstring, within 1 %
+    for name in ("F_eq", "F_eq_smooth"):
+        assert c[name]["value"] == pytest.approx(c[name]["target"], rel=0.01), name
     for png in ("fig5b_force_vectors.png", "fig6_damping.png", "fig7_loading_speed.png",
                 "fig9_distortion.png"):
         assert (out / png).stat().st_size > 0
