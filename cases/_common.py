@@ -374,7 +374,9 @@ def format_target(c):
         rng = f"≥ {_fmt(lo * k)}{u}"
     else:
         rng = f"≤ {_fmt(hi * k)}{u}"
-    return rng if t is None else f"{rng} (paper {_fmt(t)}{u})"
+    if t is None or t in (lo * k if lo is not None else None, hi * k if hi is not None else None):
+        return rng
+    return f"{rng} (paper {_fmt(t)}{u})"
 
 
 class Stopwatch:

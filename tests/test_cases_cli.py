@@ -46,16 +46,19 @@ def test_photoelastic_quick(tmp_path):
     out = tmp_path / "pe"
     assert cli.main(["run", "photoelastic", "--preset", "quick", "--out", str(out)]) == 0
     s = _summary(out)
-    ratio = s["figures"]["F_H_over_F_V"]
+    assert common.validate(s) == []
+    ratio = common.checks_by_name(s)["F_H_over_F_V"]
     assert ratio["target"] == pytest.approx(0.39)
+    assert ratio["tolerance"] == {"rel": 0.05}
     assert abs(ratio["value"] - 0.39) <= 0.1
-    walls = s["table1"]["stage_A"]["walls"]
+    table = s["data"]["table1"]["stage_A"]
+    walls = table["walls"]
     assert len(walls) == 4
     for w in walls:
         assert {"F1", "F2", "e_over_half_L_percent"} <= set(w)
     # equilibrium of the walls' forces (the discs are at rest)
-    assert abs(sum(w["F1"] for w in walls)) < 0.01 * s["table1"]["stage_A"]["F_V"]
-    assert abs(sum(w["F2"] for w in walls)) < 0.01 * s["table1"]["stage_A"]["F_V"]
+    assert abs(sum(w["F1"] for w in walls)) < 0.01 * table["F_V"]
+    assert abs(sum(w["F2"] for w in walls)) < 0.01 * table["F_V"]
     assert (out / "fig11_force_vectors.png").stat().st_size > 0
     assert list(out.glob("*.pvd"))
 
