@@ -258,12 +258,13 @@ def plot_models(models_xy, png, title=None):
         ax.autoscale_view()
         if wide:
             ax.set_xlim(m.origin[0], m.origin[0] + min(W, 2.0))
+        ax.set_xlabel("x (m)", fontsize=8)
+        ax.set_ylabel("y (m)", fontsize=8)
+        ax.tick_params(labelsize=8)
     if title:
         fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
-    return png
+    return common.save(fig, png)
 
 
 def rel(a, b):
@@ -271,18 +272,30 @@ def rel(a, b):
     return abs(a - b) / abs(b) if b else None
 
 
-def finish(summary, out, hist, plot, watch):
-    """The end of a case's ``run``: histories, plots (``plot()``), run time, summary."""
+def count_check(m, paper_count):
+    """Reported-only check of a model's particle count (FVM: cells) beside the paper's,
+    which does not always follow from its radii (spec: report it beside the paper's)."""
+    what = "cells" if m.is_fvm else "particles"
+    return common.check(f"{m.name}.count", m.count[what], paper_count, None, what,
+                        f"{LABELS.get(m.name, m.name)}: {what} beside the paper's count")
+
+
+def finish(case, preset, checks, data, out, hist, plot, watch, threads=None, paper=None,
+           notes=None):
+    """The end of a case's ``run``: histories, plots (``plot()``), then the summary
+    (:func:`cases._common.summary`) written to ``out/summary.json`` and returned."""
     common.save_histories(out / "histories.h5", hist)
     plot()
-    summary["runtime_s"] = watch()
-    common.write_summary(out, summary)
-    return summary
+    s = common.summary(case, preset, checks, data, watch(), threads=threads, paper=paper,
+                       notes=notes)
+    common.write_summary(out, s)
+    return s
 
 
 def main(case, run, doc, argv=None):
-    """Command line of a PCMM case: ``run`` with the parsed options, one summary line."""
+    """Command line of a PCMM case: ``run`` with the parsed options, then its checks."""
     args, out = common.parse(case, argv, description=doc.splitlines()[0])
     s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    print(f"summary: {out / 'summary.json'}; pass = {s['pass']}; {s['runtime_s']:.0f} s")
+    common.print_checks(s)
+    print(f"summary: {out / 'summary.json'}")
     return 0
