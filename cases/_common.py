@@ -341,7 +341,7 @@ def print_checks(s, file=None):
 
 
 # ------------------------------------------------------ formatting of checks
-_SCALE = {"N/m": (1e-3, "kN/m")}
+_SCALE = {"N/m": (1e-3, "kN/m"), "deg": (1.0, "°")}
 
 
 def _fmt(v, unit=""):
@@ -451,16 +451,18 @@ def save_histories(path, runs):
 
 
 def plot_histories(source, png, title=None, names=None, components=None, units=None,
-                   time_label="time (s)", time_scale=1.0):
+                   scales=None, time_label="time (s)", time_scale=1.0):
     """PNG of monitor histories, one panel per monitor, every axis with its unit.
 
     ``source``: a Simulation or {monitor: (times, values)}. ``names``: {monitor: label
     of its axis} (default: the monitor's name); ``components``: {monitor: [names of
     its components]} for the legend of a vector-valued monitor; ``units``: {monitor:
-    unit} (shown in brackets; "" for a pure number). ``time_scale`` multiplies the
-    times (1e3 with ``time_label="time (ms)"``)."""
+    unit} (shown in brackets; "–" for a pure number); ``scales``: {monitor: factor}
+    that the values are multiplied by to be in that unit. ``time_scale`` multiplies
+    the times (1e3 with ``time_label="time (ms)"``)."""
     hist = source.histories() if hasattr(source, "histories") else source
     names, components, units = names or {}, components or {}, units or {}
+    scales = scales or {}
     plt = pyplot()
     keys = [k for k, (t, v) in hist.items() if len(t)]
     fig, axes = plt.subplots(len(keys) or 1, 1, figsize=(7, 1.0 + 2.2 * max(len(keys), 1)),
@@ -468,7 +470,7 @@ def plot_histories(source, png, title=None, names=None, components=None, units=N
     for ax, key in zip(axes[:, 0], keys):
         t, v = hist[key]
         t = np.asarray(t, dtype=float) * time_scale
-        v = np.asarray(v, dtype=float).reshape(len(t), -1)
+        v = np.asarray(v, dtype=float).reshape(len(t), -1) * scales.get(key, 1.0)
         comp = components.get(key) or ([key] if v.shape[1] == 1 else
                                        [f"{key} {c + 1}" for c in range(v.shape[1])])
         for c in range(v.shape[1]):
