@@ -405,6 +405,8 @@ def format_target(c):
     if "rel" in tol:
         return f"{_fmt(t)}{u} ± {100 * tol['rel']:g} %"
     if "abs" in tol:
+        if tol["abs"] == 0:
+            return f"= {_fmt(t)}{u}"
         return f"{_fmt(t)} ± {_fmt(tol['abs'] * k)}{u}"
     lo, hi = tol.get("min"), tol.get("max")
     if lo is not None and hi is not None:
