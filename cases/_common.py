@@ -24,13 +24,15 @@ CASES_DIR = Path(__file__).resolve().parent
 COMMAND = None
 
 
-#: wall time of each case's quick preset, seconds, measured with ``--threads 1`` on a
-#: machine of 2 CPU cores (shared), 2026-12-04; shown by ``--help``
+#: wall time of each case's quick preset, seconds, as ``--help`` shows it; written by
+#: ``python -m cases.report --write`` from the summaries (docs/cases.md)
+# quick-times:start
 QUICK_WALL_S = {
     "nine_disc": 19, "photoelastic": 43, "elastic_gravity": 18, "wave_bar": 52,
     "uniaxial_compression": 34, "biaxial": 92, "contact_burst": 40,
 }
 QUICK_MEASURED = "measured with --threads 1 on 2 CPU cores, 2026-12-04"
+# quick-times:end
 
 
 def duration(seconds):
@@ -344,7 +346,9 @@ def print_checks(s, file=None):
 _SCALE = {"N/m": (1e-3, "kN/m"), "deg": (1.0, "°")}
 
 
-def _fmt(v, unit=""):
+def _fmt(v, measured=False):
+    """A number for a table: 4 significant digits (a measured value keeps its trailing
+    zeros: 1.000), integers as they are."""
     if v is None:
         return "–"
     if isinstance(v, bool):
@@ -352,15 +356,13 @@ def _fmt(v, unit=""):
     if isinstance(v, str):
         return v
     if isinstance(v, list):
-        return "[" + ", ".join(_fmt(x) for x in v) + "]"
+        return "[" + ", ".join(_fmt(x, measured) for x in v) + "]"
     if isinstance(v, dict):
-        return ", ".join(f"{k} {_fmt(x)}" for k, x in v.items())
-    if v == 0:
-        return "0"
-    a = abs(v)
-    if a >= 1e5 or a < 1e-3:
-        return f"{v:.3g}"
-    return f"{v:.3g}" if a < 1 else f"{v:.4g}" if a < 1e3 else f"{v:.0f}"
+        return ", ".join(f"{k} {_fmt(x, measured)}" for k, x in v.items())
+    if isinstance(v, int) or v == 0:
+        return str(int(v)) if float(v).is_integer() and abs(v) < 1e6 else f"{v:.4g}"
+    text = f"{v:#.4g}" if measured and 1e-3 <= abs(v) < 1e5 else f"{v:.4g}"
+    return text.rstrip(".")
 
 
 def _magnitude(v):
@@ -383,51 +385,48 @@ def _scaled(c):
 def _times(v, k):
     if isinstance(v, list):
         return [_times(x, k) for x in v]
-    return v * k if _number(v) else v
+    if not _number(v) or k == 1.0:
+        return v
+    return v * k
+
+
+def _with_unit(text, unit):
+    if not unit or text == "–":
+        return text
+    return f"{text}{unit}" if unit == "°" else f"{text} {unit}"
 
 
 def format_value(c):
     """The value of a check with its unit, for a table or a log line."""
     k, unit = _scaled(c)
-    s = _fmt(_times(c["value"], k))
-    return f"{s} {unit}".strip() if c["value"] is not None else s
+    return _with_unit(_fmt(_times(c["value"], k), measured=True), unit)
 
 
 def format_target(c):
     """The target and tolerance of a check, e.g. '0.39 ± 5 %', '≤ 0.05', '= toppled'."""
     k, unit = _scaled(c)
     t, tol = _times(c["target"], k), c["tolerance"]
-    u = f" {unit}" if unit else ""
+    u = lambda text: _with_unit(text, unit)      # noqa: E731
     if tol is None:
-        return "–" if t is None else f"{_fmt(t)}{u} (reported)"
+        return "–" if t is None else f"{u(_fmt(t))} (reported)"
     if "equal" in tol:
         return f"= {_fmt(t)}"
     if "rel" in tol:
-        return f"{_fmt(t)}{u} ± {100 * tol['rel']:g} %"
+        return f"{u(_fmt(t))} ± {100 * tol['rel']:g} %"
     if "abs" in tol:
         if tol["abs"] == 0:
-            return f"= {_fmt(t)}{u}"
-        return f"{_fmt(t)} ± {_fmt(tol['abs'] * k)}{u}"
+            return f"= {u(_fmt(t))}"
+        return f"{_fmt(t)} ± {u(_fmt(tol['abs'] * k))}"
     lo, hi = tol.get("min"), tol.get("max")
     if lo is not None and hi is not None:
-        rng = f"{_fmt(lo * k)}–{_fmt(hi * k)}{u}"
+        rng = f"{_fmt(lo * k)}–{u(_fmt(hi * k))}"
     elif lo is not None:
-        rng = f"≥ {_fmt(lo * k)}{u}"
+        rng = f"≥ {u(_fmt(lo * k))}"
     else:
-        rng = f"≤ {_fmt(hi * k)}{u}"
+        rng = f"≤ {u(_fmt(hi * k))}"
     if t is None or t in (lo * k if lo is not None else None, hi * k if hi is not None else None):
         return rng
-    return f"{rng} (paper {_fmt(t)}{u})"
-
-
-class Stopwatch:
-    """Wall-clock seconds since creation (for the runtime in the summary)."""
-
-    def __init__(self):
-        self.t0 = time.perf_counter()
-
-    def __call__(self):
-        return time.perf_counter() - self.t0
+    return f"{rng} (paper {u(_fmt(t))})"
 
 
 # ----------------------------------------------------------------- histories
@@ -616,11 +615,15 @@ def _case_info(path):
     return first, has_main
 
 
+#: modules of ``cases`` with a ``main`` that are tools, not cases
+NOT_CASES = ("report",)
+
+
 def list_cases():
     """{name: one-line description} of the modules in ``cases`` with a ``main``."""
     found = {}
     for mod in sorted(pkgutil.iter_modules([str(CASES_DIR)]), key=lambda m: m.name):
-        if mod.name.startswith("_") or mod.ispkg:
+        if mod.name.startswith("_") or mod.ispkg or mod.name in NOT_CASES:
             continue
         desc, has_main = _case_info(CASES_DIR / f"{mod.name}.py")
         if has_main:

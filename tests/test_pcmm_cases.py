@@ -132,3 +132,15 @@ def test_elastic_gravity_sigma_yy_within_5_percent_of_the_elastic_solution(gravi
     assert c["value"] <= 0.05
     assert c["tolerance"] == {"max": 0.05}
     assert c["pass"] is True
+
+
+@pytest.mark.parametrize("fixture", ["wave", "uniaxial", "gravity"])
+def test_quick_summaries_follow_the_schema(fixture, request):
+    """Each case's quick summary follows the schema (cases._common.validate: the keys,
+    every check's pass from its value, target and tolerance, the overall pass = all of
+    the compared checks) and is what summary.json holds."""
+    s = request.getfixturevalue(fixture)
+    assert common.validate(s) == []
+    compared = [c["pass"] for c in s["checks"] if c["pass"] is not None]
+    assert compared and s["pass"] is all(compared)
+    assert s["preset"] == "quick" and s["wall_time_s"] > 0
