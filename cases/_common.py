@@ -429,6 +429,16 @@ def format_target(c):
     return f"{rng} (paper {u(_fmt(t))})"
 
 
+class Stopwatch:
+    """Wall-clock seconds since creation (for the run time in the summary)."""
+
+    def __init__(self):
+        self.t0 = time.perf_counter()
+
+    def __call__(self):
+        return time.perf_counter() - self.t0
+
+
 # ----------------------------------------------------------------- histories
 def save_histories(path, runs):
     """Write the monitor histories of several runs to one HDF5 file.

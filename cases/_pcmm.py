@@ -236,7 +236,7 @@ def plot_models(models_xy, png, title=None):
     W, H = models_xy[0].W, models_xy[0].H
     wide = W / H > 3
     if wide:
-        fig, axes = plt.subplots(n, 1, figsize=(12, 1.2 * n + 0.8), squeeze=False)
+        fig, axes = plt.subplots(n, 1, figsize=(7, 1.9 * n + 0.6), squeeze=False)
     else:
         fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.2 * H / W + 0.6), squeeze=False)
     for ax, m in zip(axes.ravel(), models_xy):

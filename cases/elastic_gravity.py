@@ -334,7 +334,7 @@ def plots(runs, out, ref_curves=None):
                       title="Models and initial PCMM element systems (paper Figs. 7-8)")
     for key, fname, label, ana in (
             ("uy", "fig9_displacement.png", "vertical displacement (mm)", uy_analytic),
-            ("syy", "fig10_stress.png", "vertical stress σ_yy (kPa)", sigma_target)):
+            ("syy", "fig10_stress.png", "vertical stress σ_yy (kPa, tension +)", sigma_target)):
         k = 1e3 if key == "uy" else 1e-3          # displacements in mm, stresses in kPa
         fig, ax = plt.subplots(figsize=(5, 5))
         for m in runs:
@@ -352,7 +352,8 @@ def plots(runs, out, ref_curves=None):
                     label="elastic solution (fixed base)")
         ax.set_xlabel(label)
         ax.set_ylabel("model height y (m)")
-        ax.set_title(f"x = {X_MON} m")
+        ax.set_title(f"Rock under gravity: {'u_y' if key == 'uy' else 'σ_yy'} at x = {X_MON:g} m "
+                     f"(paper Fig. {9 if key == 'uy' else 10})", fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         fig.tight_layout()

@@ -298,7 +298,8 @@ def plot_fig7(panels, png):
     for ax, (title, runs) in zip(axes[:, 0], panels):
         for (label, run), color in zip(runs, ("tab:blue", "tab:orange")):
             ax.plot(run.cycles, run.fn, color=color, lw=1.0, label=label)
-            ax.axvline(run.load_cycles, color=color, ls=":", lw=0.8)
+            ax.axvline(run.load_cycles, color=color, ls=":", lw=0.8,
+                       label=f"{label.split(':')[0]}: walls stop")
         ax.set_xlabel("calculation cycles (time steps)")
         ax.set_ylabel("normal force at C\n(C&S force units)")
         ax.set_title(title, fontsize=10)

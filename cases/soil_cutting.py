@@ -491,7 +491,7 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
             "paper-equivalent time of the largest P1; within 1 s" + peak_note),
         common.check(
             "P1_end", float(vP1[-1]), PAPER["P1_end_m"], common.rel(0.10) if end_ok else None,
-            "m", f"P1 at the end of this run; within 10 %" + end_note),
+            "m", "P1 at the end of this run; within 10 %" + end_note),
         common.check(
             "P4_end_bulk_stress", float(vP4[-1]), PAPER["P4_end_Pa"],
             common.rel(0.10) if end_ok else None, "Pa",

@@ -241,6 +241,8 @@ def plots(runs, out, sc):
     ax.axhline(sc / 1e6, color="k", ls="--", lw=1, label=f"2c cosφ/(1−sinφ) = {sc / 1e6:.2f} MPa")
     ax.set_xlabel("axial strain (‰)")
     ax.set_ylabel("axial stress (MPa, compression +)")
+    ax.set_title("Uniaxial compression: plate stress against strain (paper Fig. 13)",
+                 fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

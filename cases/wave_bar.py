@@ -202,8 +202,8 @@ def plots(runs, out, c_bar):
     _pcmm.plot_models(runs, out / "fig14_models.png",
                       title="Bar models, first 2 m (paper Fig. 14)")
     tt = np.linspace(0.0, T_END, 1001)
-    for key, fname, label in (("vx", "fig15_velocity.png", "horizontal velocity (m/s)"),
-                              ("sxx", "fig16_stress.png", "σ_xx (MPa)")):
+    for key, fname, label, fig_no in (("vx", "fig15_velocity.png", "horizontal velocity (m/s)", 15),
+                                      ("sxx", "fig16_stress.png", "σ_xx (MPa, tension +)", 16)):
         fig, ax = plt.subplots(figsize=(7, 4))
         for m in runs:
             y = m.vx if key == "vx" else m.sxx / 1e6
@@ -215,7 +215,8 @@ def plots(runs, out, c_bar):
         ax.plot(tt * 1e3, ana, "k--", lw=1, label="incident pulse, c = sqrt(E/ρ(1−ν²))")
         ax.set_xlabel("time (ms)")
         ax.set_ylabel(label)
-        ax.set_title("x = 10 m")
+        ax.set_title(f"Wave bar: {'velocity' if key == 'vx' else 'stress'} at x = 10 m "
+                     f"(paper Fig. {fig_no})", fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         fig.tight_layout()
