@@ -236,9 +236,11 @@ def plot_models(models_xy, png, title=None):
     W, H = models_xy[0].W, models_xy[0].H
     wide = W / H > 3
     if wide:
-        fig, axes = plt.subplots(n, 1, figsize=(7, 1.9 * n + 0.6), squeeze=False)
+        fig, axes = plt.subplots(n, 1, figsize=(7, 1.9 * n + 0.6), squeeze=False,
+                                 layout="constrained")
     else:
-        fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.2 * H / W + 0.6), squeeze=False)
+        fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 2.6 * H / W + 1.0), squeeze=False,
+                                 layout="constrained")
     for ax, m in zip(axes.ravel(), models_xy):
         if m.is_fvm:
             tri = np.asarray(m.block.triangles)
@@ -263,7 +265,6 @@ def plot_models(models_xy, png, title=None):
         ax.tick_params(labelsize=8)
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
     return common.save(fig, png)
 
 
@@ -272,12 +273,14 @@ def rel(a, b):
     return abs(a - b) / abs(b) if b else None
 
 
-def count_check(m, paper_count):
-    """Reported-only check of a model's particle count (FVM: cells) beside the paper's,
-    which does not always follow from its radii (spec: report it beside the paper's)."""
-    what = "cells" if m.is_fvm else "particles"
-    return common.check(f"{m.name}.count", m.count[what], paper_count, None, what,
-                        f"{LABELS.get(m.name, m.name)}: {what} beside the paper's count")
+def count_check(m, paper_count, what=None):
+    """Reported-only check of a model's particle count (FVM: cells, or ``what``: a key
+    of ``m.count``) beside the paper's, which does not always follow from its radii
+    (spec: report it beside the paper's)."""
+    what = what or ("cells" if m.is_fvm else "particles")
+    unit = "triangles" if what.startswith("elements") else what
+    return common.check(f"{m.name}.count", m.count[what], paper_count, None, unit,
+                        f"{LABELS.get(m.name, m.name)}: {unit} beside the paper's count")
 
 
 def finish(case, preset, checks, data, out, hist, plot, watch, threads=None, paper=None,

@@ -57,7 +57,7 @@ Decisions the paper leaves open
 
 Presets
 -------
-quick (about 2 minutes on 2 cores): one 1008-disc specimen at --confining
+quick (its measured time: --help): one 1008-disc specimen at --confining
 (200 kPa), four tests (no rolling resistance, Model 1 and Model 2 at delta = 0.4,
 Model 1 at delta = 1.6) to 12 % axial strain at 0.5 /s (faster than quasi-static,
 see above). With --delta/--model only that test runs. paper: 0.1 /s to 20 %, the

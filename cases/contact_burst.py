@@ -43,7 +43,7 @@ Presets
 -------
 - ``paper``: R = 0.01 m (40,501 rock particles), charge particles r_e = 0.01 m,
   3.6 ms.
-- ``quick`` (well under a minute on 2 cores): R = 0.04 m (101 x 26 = 2626 rock
+- ``quick`` (its measured time: --help): R = 0.04 m (101 x 26 = 2626 rock
   particles), charge particles r_e = 0.02 m (finer than the rock so that the disc
   keeps its shape), 3.6 ms.
 Both use dt_fraction 0.3 of the critical step, whose signal speed in the charge is

@@ -40,7 +40,7 @@ Presets
   (the upper, back end of the plate) move right at 0.1 m/s (vy = 0), 27.5 s of
   cutting. The elastic steel blade sets the time step (about 1e-6 s): very long
   (see docs/cases.md); runnable, not meant for a test.
-- ``quick`` (about 1.5 minutes on 2 cores): R = 0.025 m (61 x 21 = 1281
+- ``quick`` (its measured time: --help): R = 0.025 m (61 x 21 = 1281
   particles), a kinematic rigid blade (every node prescribed, so the steel does
   not limit the time step), a blade 5 x faster (0.5 m/s) and 1.2 s of cutting
   (0.6 m of blade travel, the paper's first 6 s; its 27.5 s are 2.75 m). To

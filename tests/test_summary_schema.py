@@ -100,6 +100,7 @@ def test_write_summary_refuses_a_broken_summary(tmp_path):
     (common.check("p", 0.2645e-3, 0.46e-3, common.rel(0.1), "s"), "0.2645 ms", "0.46 ms ± 10 %"),
     (common.check("p", 438.9e6, 1369e6, None, "Pa"), "438.9 MPa", "1369 MPa (reported)"),
     (common.check("p", -6.5e3, None, None, "Pa"), "-6.500 kPa", "–"),
+    (common.check("p", 32.31e9, 32e9, None, "Pa"), "32.31 GPa", "32 GPa (reported)"),
     (common.check("p", 24.11, 24.4, common.absolute(2.0), "deg"), "24.11°", "24.4 ± 2°"),
     (common.check("p", 0.0191, None, common.between(max=0.05)), "0.01910", "≤ 0.05"),
     (common.check("p", 0.52, None, common.between(0.4, 0.6), "s"), "0.5200 s", "0.4–0.6 s"),

@@ -24,7 +24,8 @@ reports against measured values, with tolerances:
   largest rise 1.5, 3.7, 7.4 and 8.9 cm (four columns: 0.3–0.6 cm);
 - the water stays weakly compressible: its fastest particle below c/5 (c =
   122 m/s; measured 8.8 m/s; the runs completed).
-Measured run time: 175-250 s for both runs on 2 shared cores (hence slow).
+Measured run time: 175-250 s for both runs on 2 shared cores with two threads, 460-500 s
+with --threads 1 (hence slow).
 """
 import math
 
