@@ -128,7 +128,7 @@ def _given():
 def test_report_renders_a_summary_into_its_rows():
     s = _given()
     assert report.render_row(s) == (
-        "| `wave_bar` | a velocity pulse along a 20 m bar, four models (Feng et al. 2015) "
+        "| `wave_bar` | a velocity pulse along a 20 m bar (Feng et al.) "
         "| 52 s | 2 of 3 | FAIL |")
     assert report.render_check(s["checks"][2]) == (
         "| random.peak_stress | 70.00 MPa | 89.4 MPa ± 10 % | FAIL |")
