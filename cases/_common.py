@@ -377,7 +377,7 @@ def _scaled(c):
     unit = c.get("unit") or ""
     big = max(_magnitude(c.get("value")), _magnitude(c.get("target")))
     if unit == "Pa" and big > 0:
-        return (1e-9, "GPa") if big >= 1e9 else (1e-6, "MPa") if big >= 1e5 else (1e-3, "kPa")
+        return (1e-9, "GPa") if big >= 1e10 else (1e-6, "MPa") if big >= 1e5 else (1e-3, "kPa")
     if unit == "s" and 0 < big < 0.1:
         return 1e3, "ms"
     return _SCALE.get(unit, (1.0, unit))
