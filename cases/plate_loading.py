@@ -237,11 +237,8 @@ def plot_shares(results, png):
         ax.bar(xs, load, w, color=colors[k], label=f"{name}: share of load")
         ax.scatter(xs, count, marker="_", s=250, color="k", zorder=3,
                    label="share of contacts" if k == 0 else None)
-    ax.axhline(20, color="tab:green", ls=":", lw=1)
-    ax.text(-0.45, 21, "paper: final ≤ 20 %", ha="left", fontsize=8, color="tab:green")
-    ax.axhline(70, color="0.4", ls=":", lw=1)
-    ax.text(-0.45, 71, "paper: initial + transition > 70 %", ha="left", fontsize=8,
-            color="0.3")
+    ax.axhline(20, color="tab:green", ls=":", lw=1, label="paper: final ≤ 20 %")
+    ax.axhline(70, color="0.4", ls=":", lw=1, label="paper: initial + transition > 70 %")
     ax.set_xticks(np.arange(len(beds)), beds)
     ax.set_ylabel("share at 900 kPa (%)")
     ax.set_ylim(0, 100)
