@@ -236,9 +236,11 @@ def plot_models(models_xy, png, title=None):
     W, H = models_xy[0].W, models_xy[0].H
     wide = W / H > 3
     if wide:
-        fig, axes = plt.subplots(n, 1, figsize=(12, 1.2 * n + 0.8), squeeze=False)
+        fig, axes = plt.subplots(n, 1, figsize=(7, 1.9 * n + 0.6), squeeze=False,
+                                 layout="constrained")
     else:
-        fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.2 * H / W + 0.6), squeeze=False)
+        fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 2.6 * H / W + 1.0), squeeze=False,
+                                 layout="constrained")
     for ax, m in zip(axes.ravel(), models_xy):
         if m.is_fvm:
             tri = np.asarray(m.block.triangles)
@@ -258,12 +260,12 @@ def plot_models(models_xy, png, title=None):
         ax.autoscale_view()
         if wide:
             ax.set_xlim(m.origin[0], m.origin[0] + min(W, 2.0))
+        ax.set_xlabel("x (m)", fontsize=8)
+        ax.set_ylabel("y (m)", fontsize=8)
+        ax.tick_params(labelsize=8)
     if title:
         fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
-    return png
+    return common.save(fig, png)
 
 
 def rel(a, b):
@@ -271,18 +273,32 @@ def rel(a, b):
     return abs(a - b) / abs(b) if b else None
 
 
-def finish(summary, out, hist, plot, watch):
-    """The end of a case's ``run``: histories, plots (``plot()``), run time, summary."""
+def count_check(m, paper_count, what=None):
+    """Reported-only check of a model's particle count (FVM: cells, or ``what``: a key
+    of ``m.count``) beside the paper's, which does not always follow from its radii
+    (spec: report it beside the paper's)."""
+    what = what or ("cells" if m.is_fvm else "particles")
+    unit = "triangles" if what.startswith("elements") else what
+    return common.check(f"{m.name}.count", m.count[what], paper_count, None, unit,
+                        f"{LABELS.get(m.name, m.name)}: {unit} beside the paper's count")
+
+
+def finish(case, preset, checks, data, out, hist, plot, watch, threads=None, paper=None,
+           notes=None):
+    """The end of a case's ``run``: histories, plots (``plot()``), then the summary
+    (:func:`cases._common.summary`) written to ``out/summary.json`` and returned."""
     common.save_histories(out / "histories.h5", hist)
     plot()
-    summary["runtime_s"] = watch()
-    common.write_summary(out, summary)
-    return summary
+    s = common.summary(case, preset, checks, data, watch(), threads=threads, paper=paper,
+                       notes=notes)
+    common.write_summary(out, s)
+    return s
 
 
 def main(case, run, doc, argv=None):
-    """Command line of a PCMM case: ``run`` with the parsed options, one summary line."""
+    """Command line of a PCMM case: ``run`` with the parsed options, then its checks."""
     args, out = common.parse(case, argv, description=doc.splitlines()[0])
     s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    print(f"summary: {out / 'summary.json'}; pass = {s['pass']}; {s['runtime_s']:.0f} s")
+    common.print_checks(s)
+    print(f"summary: {out / 'summary.json'}")
     return 0

@@ -57,7 +57,7 @@ Decisions the paper leaves open
 
 Presets
 -------
-quick (about 2 minutes on 2 cores): one 1008-disc specimen at --confining
+quick (its measured time: --help): one 1008-disc specimen at --confining
 (200 kPa), four tests (no rolling resistance, Model 1 and Model 2 at delta = 0.4,
 Model 1 at delta = 1.6) to 12 % axial strain at 0.5 /s (faster than quasi-static,
 see above). With --delta/--model only that test runs. paper: 0.1 /s to 20 %, the
@@ -432,23 +432,26 @@ def plot_fig11(results, png, confining):
         step = max(float(np.median(np.diff(c["axial_strain"]))), 1e-12)
         w = int(round(0.002 / step))
         q = 0.5 * (smooth(c["sigma_v"], w) - smooth(c["sigma_h"], w)) / 1e3
+        key = (r["task"]["model"] if r["task"]["delta"] else 0, r["task"]["delta"])
+        paper = TARGETS.get(key)
         a.plot(ea, q, color=color, lw=1.2,
-               label=f"{label}: φ = {r['phi']['phi_peak']:.1f}°/{r['phi']['phi_residual']:.1f}°")
+               label=f"{label}: φ = {r['phi']['phi_peak']:.1f}°/{r['phi']['phi_residual']:.1f}°"
+                     + (f" (paper {paper[0]}°/{paper[1]}°)" if paper else ""))
         b.plot(ea, 100 * c["volumetric_strain"], color=color, lw=1.2, label=label)
     a.set_xlabel("axial strain (%)")
     a.set_ylabel("(σ_v − σ_h)/2 (kPa)")
     a.set_title("(a) deviatoric stress", fontsize=10)
     a.legend(fontsize=8)
     b.set_xlabel("axial strain (%)")
-    b.set_ylabel("volumetric strain ε_a + ε_h (%), compression +")
+    b.set_ylabel("volumetric strain ε_a + ε_h (%)\ncompression +")
     b.set_title("(b) volumetric strain", fontsize=10)
     b.legend(fontsize=8)
     for ax in (a, b):
         ax.grid(alpha=0.3)
-    fig.suptitle(f"Biaxial tests at σ_h = {confining / 1e3:g} kPa (Jiang et al. 2005, Fig. 11)")
+    fig.suptitle(f"Biaxial tests at σ_h = {confining / 1e3:g} kPa (Jiang et al. 2005, Fig. 11); "
+                 "φ peak/residual")
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_fig12(env, png):
@@ -482,8 +485,7 @@ def plot_fig12(env, png):
         ax.set_ylim(bottom=0)
     fig.suptitle("Strength envelopes (Jiang et al. 2005, Fig. 12)")
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_fig13(results, png):
@@ -515,14 +517,13 @@ def plot_fig13(results, png):
     ax.plot([], [], "*", color="k", ms=10, label="paper, peak (Model 1 / none)")
     ax.plot([], [], "*", color="0.5", ms=10, label="paper, residual")
     ax.plot([], [], "P", color="k", ms=9, label="paper, Model 2 at δ = 0.4")
-    ax.set_xlabel("shape parameter δ")
+    ax.set_xlabel("shape parameter δ (–)")
     ax.set_ylabel("internal friction angle φ (°)")
     ax.set_title("φ against δ (Jiang et al. 2005, Fig. 13)", fontsize=10)
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_specimen(spec, png, title):
@@ -532,28 +533,48 @@ def plot_specimen(spec, png, title):
     fig, ax = plt.subplots(figsize=(4.2, 6.5))
     walls = [np.array([[x0, y0], [x1, y0]]), np.array([[x1, y0], [x1, y1]]),
              np.array([[x1, y1], [x0, y1]]), np.array([[x0, y1], [x0, y0]])]
-    common.force_vector_plot(ax, p["position"], p["radius"], spec.sim.contacts.numpy(),
-                             walls=walls)
-    ax.set_title(title, fontsize=9)
-    ax.set_axis_off()
+    fmax = common.force_vector_plot(ax, p["position"], p["radius"], spec.sim.contacts.numpy(),
+                                    walls=walls)
+    from matplotlib.ticker import FuncFormatter
+    mm = FuncFormatter(lambda v, _: f"{1e3 * v:.0f}")
+    ax.xaxis.set_major_formatter(mm)
+    ax.yaxis.set_major_formatter(mm)
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(f"{title}\nbar width ∝ contact force (widest = {fmax:.3g} N)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 # ------------------------------------------------------------------ the case
-def _figures(results):
-    figs = {}
+#: tolerance of a friction angle against the paper's (degrees): the scatter of one
+#: 1008-disc test with the specimen and from run to run (module docstring)
+PHI_TOL = 2.0
+
+
+def _phi_check(name, value, target, note):
+    return common.check(name, value, target,
+                        common.absolute(PHI_TOL) if target is not None else None, "deg",
+                        note + (f"; within {PHI_TOL:g}°, the scatter of one test (module "
+                                "docstring)" if target is not None else
+                                "; no paper value for this material"))
+
+
+def _figures(results, rate_note=""):
+    """Checks of each test's peak and residual φ against the paper's."""
+    figs = []
     for r in results:
         key = (r["task"]["model"] if r["task"]["delta"] else 0, r["task"]["delta"])
         target = TARGETS.get(key)
         s = f"{r['task']['confining'] / 1e3:g}kPa"
-        figs[f"phi_peak_{r['name']}_{s}"] = common.figure(
-            r["phi"]["phi_peak"], target[0] if target else None, "deg",
-            f"largest sin φ, at axial strain {100 * r['phi']['strain_at_peak']:.2f} %")
-        figs[f"phi_residual_{r['name']}_{s}"] = common.figure(
-            r["phi"]["phi_residual"], target[1] if target else None, "deg",
-            "mean stresses over the last quarter of the axial strain")
+        figs.append(_phi_check(
+            f"phi_peak_{r['name']}_{s}", r["phi"]["phi_peak"], target[0] if target else None,
+            f"largest sin φ, at axial strain {100 * r['phi']['strain_at_peak']:.2f} %"
+            + rate_note))
+        figs.append(_phi_check(
+            f"phi_residual_{r['name']}_{s}", r["phi"]["phi_residual"],
+            target[1] if target else None,
+            "mean stresses over the last quarter of the axial strain" + rate_note))
     return figs
 
 
@@ -585,46 +606,51 @@ def _main_sweep(args, out, cfg, clock):
     save_results(out / "sweep.h5", results, extra={"envelopes": env})
     plot_fig12(env, out / "fig12_envelopes.png")
     plot_fig13(results, out / "fig13_phi_delta.png")
-    figures = {}
+    checks = []
     for (model, delta), (pk, rs) in TARGETS.items():
         name = material_name(model, delta)
         if name in env:
-            figures[f"envelope_phi_peak_{name}"] = common.figure(
-                env[name]["peak"]["phi"], pk, "deg", "slope of the peak envelope, "
-                f"apparent cohesion {env[name]['peak']['cohesion'] / 1e3:.1f} kPa")
-            figures[f"envelope_phi_residual_{name}"] = common.figure(
-                env[name]["residual"]["phi"], rs, "deg", "slope of the residual envelope")
-            figures[f"mean_phi_peak_{name}"] = common.figure(
-                float(np.mean(env[name]["phi_peak_tests"])), pk, "deg",
-                "mean of the tests at the three confining stresses")
-            figures[f"mean_phi_residual_{name}"] = common.figure(
-                float(np.mean(env[name]["phi_residual_tests"])), rs, "deg",
-                "mean of the tests at the three confining stresses")
+            checks += [
+                _phi_check(f"envelope_phi_peak_{name}", env[name]["peak"]["phi"], pk,
+                           "slope of the peak envelope, apparent cohesion "
+                           f"{env[name]['peak']['cohesion'] / 1e3:.1f} kPa"),
+                _phi_check(f"envelope_phi_residual_{name}", env[name]["residual"]["phi"], rs,
+                           "slope of the residual envelope"),
+                _phi_check(f"mean_phi_peak_{name}", float(np.mean(env[name]["phi_peak_tests"])),
+                           pk, "mean of the tests at the three confining stresses"),
+                _phi_check(f"mean_phi_residual_{name}",
+                           float(np.mean(env[name]["phi_residual_tests"])), rs,
+                           "mean of the tests at the three confining stresses"),
+            ]
     names = ("none", "model2_delta0.4", "model1_delta0.4")
     if all(n in env for n in names):
         none, m2, m1 = (float(np.mean(env[n]["phi_peak_tests"])) for n in names)
-        figures["model2_between_none_and_model1"] = common.figure(
-            bool(none < m2 < m1), True, "",
+        checks.append(common.check(
+            "model2_between_none_and_model1", bool(none < m2 < m1), True, common.EQUAL, "",
             f"mean peak phi at delta = 0.4: none {none:.2f}, Model 2 {m2:.2f}, "
             f"Model 1 {m1:.2f} (the paper: 24.4, 26.5, 29.0; also 28.8 for Model 1 in "
-            "its §5.2)")
+            "its §5.2)"))
     m1 = {r["task"]["delta"]: r for r in results if r["task"]["model"] == 1
           or r["task"]["delta"] == 0.0}
-    summary = {
-        "case": CASE, "preset": args.preset, "mode": "sweep",
-        "paper": "Jiang, Yu & Harris (2005), Comput. Geotech. 32, §5, Figs. 12-13",
-        "figures": figures,
+    increases = bool(np.all(np.diff(
+        [np.mean([r["phi"]["phi_peak"] for r in results if r["task"]["delta"] == d
+                  and r["task"]["model"] in (0, 1)]) for d in sorted(m1)]) > 0))
+    checks.append(common.check(
+        "model1_phi_peak_increases_with_delta", increases, True, common.EQUAL, "",
+        "mean peak φ of Model 1 over the confining stresses rises with δ (paper Fig. 13)"))
+    data = {
+        "mode": "sweep",
         "envelopes": env,
         "tests": [{"task": r["task"], "phi": r["phi"], "sigma_h_hold": r["hold"],
                    "void_ratio": r["before"]["void_ratio"], "wall_s": r["wall_s"]}
                   for r in results],
-        "model1_phi_peak_increases_with_delta": bool(np.all(np.diff(
-            [np.mean([r["phi"]["phi_peak"] for r in results if r["task"]["delta"] == d
-                      and r["task"]["model"] in (0, 1)]) for d in sorted(m1)]) > 0)),
-        "runtime_s": clock(),
     }
+    summary = common.summary(
+        CASE, args.preset, checks, data, clock(), threads=args.threads,
+        paper="Jiang, Yu & Harris (2005), Comput. Geotech. 32, §5, Figs. 12-13")
     common.write_summary(out, summary)
-    print(f"biaxial sweep: {len(results)} tests in {clock():.0f} s -> {out}")
+    print(f"biaxial sweep: {len(results)} tests -> {out}")
+    common.print_checks(summary)
     return summary
 
 
@@ -680,8 +706,19 @@ def main(argv=None):
                   f"e = {spec0.void_ratio():.3f}\n{1e3 * spec0.width:.1f} x "
                   f"{1e3 * spec0.height:.1f} mm, σ = {args.confining / 1e3:g} kPa")
     if first["spec"] is not None:
-        common.plot_histories(first["spec"].sim, out / "monitors.png",
-                              title=f"{first['name']}: wall stresses and specimen size")
+        hist = first["spec"].sim.histories()
+        tags = {k.rsplit("_", 1)[0] for k in hist if k.startswith("shear")}
+        names, units, scales = {}, {}, {}
+        for tag in tags:
+            for k, label, unit, scale in (("sigma_h", "σ_h, side walls", "kPa", 1e-3),
+                                          ("sigma_v", "σ_v, top and bottom", "kPa", 1e-3),
+                                          ("width", "specimen width", "mm", 1e3),
+                                          ("height", "specimen height", "mm", 1e3)):
+                names[f"{tag}_{k}"], units[f"{tag}_{k}"] = label, unit
+                scales[f"{tag}_{k}"] = scale
+        common.plot_histories(hist, out / "monitors.png",
+                              title=f"{_label(first['name'])[1]}: wall stresses and specimen size",
+                              names=names, units=units, scales=scales)
     env = None
     if envelope_confining:
         env = envelopes(results)
@@ -690,36 +727,36 @@ def main(argv=None):
 
     g = spec0.grading
     before = first["before"]
-    figures = _figures(results)
-    figures.update({
-        "void_ratio": common.figure(before["void_ratio"], 0.25, "",
-                                    "planar void ratio of the specimen under σ_h before "
-                                    "compression"),
-        "sigma_h_hold": common.figure(max(r["hold"] for r in results), "< 0.02", "fraction",
-                                      "largest deviation of σ_h from its target, averaged "
-                                      "over 0.5 % axial strain, over all tests"),
-        "width_mm": common.figure(1e3 * before["width"], 180.0, "mm",
-                                  "the size follows from the discs and the void ratio"),
-        "height_mm": common.figure(1e3 * before["height"], 306.7, "mm", ""),
-        "d50_mm": common.figure(1e3 * g["d50"], 7.6, "mm", "by area"),
-        "cu": common.figure(g["cu"], 1.3, "", "d60/d10 by area"),
-    })
+    rate_note = (f"; strain rate {cfg['strain_rate']:g} /s at 200 kPa, which reads about "
+                 "2° high (module docstring)" if args.preset == "quick" else "")
+    checks = _figures(results, rate_note)
+    checks += [
+        common.check("void_ratio", before["void_ratio"], 0.25, common.absolute(0.005), "",
+                     "planar void ratio of the specimen under σ_h before compression "
+                     "(preparation stops within 0.002 of it)"),
+        common.check("sigma_h_hold", max(r["hold"] for r in results), None,
+                     common.between(max=0.02), "",
+                     "largest deviation of σ_h from its target, averaged over 0.5 % axial "
+                     "strain, over all tests, as a fraction of σ_h"),
+        common.check("width", 1e3 * before["width"], 180.0, common.rel(0.02), "mm",
+                     "the size follows from the discs and the void ratio"),
+        common.check("height", 1e3 * before["height"], 306.7, common.rel(0.02), "mm",
+                     "the size follows from the discs and the void ratio"),
+        common.check("d50", 1e3 * g["d50"], 7.6, common.rel(0.02), "mm", "by area"),
+        common.check("cu", g["cu"], 1.3, common.absolute(0.03), "", "d60/d10 by area"),
+    ]
     if env:
         for name, e in env.items():
             key = {"none": (0, 0.0), "model1_delta0.4": (1, 0.4),
                    "model2_delta0.4": (2, 0.4)}.get(name)
             t = TARGETS.get(key, (None, None))
-            figures[f"envelope_phi_peak_{name}"] = common.figure(
-                e["peak"]["phi"], t[0], "deg",
-                f"peak envelope slope; apparent cohesion {e['peak']['cohesion'] / 1e3:.1f} kPa")
-            figures[f"envelope_phi_residual_{name}"] = common.figure(
-                e["residual"]["phi"], t[1], "deg", "residual envelope slope")
+            checks.append(_phi_check(
+                f"envelope_phi_peak_{name}", e["peak"]["phi"], t[0],
+                f"peak envelope slope; apparent cohesion {e['peak']['cohesion'] / 1e3:.1f} kPa"))
+            checks.append(_phi_check(f"envelope_phi_residual_{name}", e["residual"]["phi"],
+                                     t[1], "residual envelope slope"))
     d50 = g["d50"]
-    summary = {
-        "case": CASE,
-        "preset": args.preset,
-        "paper": "Jiang, Yu & Harris (2005), Comput. Geotech. 32, §5, Figs. 10-13",
-        "figures": figures,
+    data = {
         "tests": [{"name": r["name"], "confining": r["task"]["confining"], "phi": r["phi"],
                    "sigma_h_hold": r["hold"], "steps": r["steps"], "wall_s": r["wall_s"]}
                   for r in results],
@@ -732,12 +769,15 @@ def main(argv=None):
             "dt": spec0.sim.dt,
             "inertial_number": rate * d50 * math.sqrt(DENSITY / args.confining),
         },
-        "runtime_s": clock(),
     }
+    summary = common.summary(
+        CASE, args.preset, checks, data, clock(), threads=args.threads,
+        paper="Jiang, Yu & Harris (2005), Comput. Geotech. 32, §5, Figs. 10-13")
     common.write_summary(out, summary)
     print(f"biaxial ({args.preset}): e = {before['void_ratio']:.4f}, "
           + ", ".join(f"{r['name']} {r['phi']['phi_peak']:.1f}/{r['phi']['phi_residual']:.1f}°"
-                      for r in main_runs) + f"; {clock():.1f} s -> {out}")
+                      for r in main_runs) + f" -> {out}")
+    common.print_checks(summary)
     return summary
 
 

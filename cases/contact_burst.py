@@ -43,7 +43,7 @@ Presets
 -------
 - ``paper``: R = 0.01 m (40,501 rock particles), charge particles r_e = 0.01 m,
   3.6 ms.
-- ``quick`` (well under a minute on 2 cores): R = 0.04 m (101 x 26 = 2626 rock
+- ``quick`` (its measured time: --help): R = 0.04 m (101 x 26 = 2626 rock
   particles), charge particles r_e = 0.02 m (finer than the rock so that the disc
   keeps its shape), 3.6 ms.
 Both use dt_fraction 0.3 of the critical step, whose signal speed in the charge is
@@ -214,18 +214,48 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
     ratio = {"P5/P4": peaks["P5"] / peaks["P4"] if peaks["P4"] > 0 else None,
              "P6/P4": peaks["P6"] / peaks["P4"] if peaks["P4"] > 0 else None}
     st = sim._cont.jwl_state()[m["charge"].ids]
-    summary = {
-        "case": CASE, "preset": preset,
+    R = m["R"]
+    at_end = common.reached(sim.time, DURATION)
+    checks = []
+    for key, value, what in (("crater_width", width, "width at the top"),
+                             ("crater_depth", depth, "depth")):
+        target = PAPER[key + "_m"]
+        checks.append(common.check(
+            key, value, target,
+            common.absolute(max(0.1 * target, 2 * R)) if at_end else None, "m",
+            f"crater {what} at 3.6 ms by the measure of the module docstring; within 10 % "
+            f"or one particle diameter ({2 * R:g} m, the measure's resolution), whichever "
+            "is larger (decided here)" if at_end else
+            f"crater {what}: the paper's is at 3.6 ms, this run ends at "
+            f"{sim.time * 1e3:.2f} ms: reported, not compared"))
+    checks.append(common.check(
+        "P1_start", start, PAPER["P1_start_s"], common.rel(0.10), "s",
+        "first |u_x| > 1 % of its maximum in the first ms; the paper's 0.46 ms (its "
+        "threshold is not given) is nearer the Rayleigh wave's arrival "
+        f"({dist / c_r * 1e3:.2f} ms) than the P-wave's ({dist / c_p * 1e3:.2f} ms); "
+        "within 10 % (decided here)"))
+    checks.append(common.check(
+        "P1_start_vs_p_wave", start, dist / c_p, common.rel(0.10), "s",
+        "the same start against the P-wave's arrival from the charge's contact point "
+        f"(c_p = {c_p:.0f} m/s, {dist:.2f} m): P1 starts to move when the P-wave arrives"))
+    for k, v in peaks.items():
+        checks.append(common.check(
+            f"{k}_peak_pressure", v, PAPER[k + "_peak_Pa"], None, "Pa",
+            f"depth {MONITOR_DEPTH[k]} m below the charge; reported, not compared: the "
+            "paper does not give its monitor positions (spec: compare the decay)"))
+    for k in ratio:
+        checks.append(common.check(
+            f"{k}_peak_ratio", ratio[k], paper_ratio[k], common.rel(0.10), "",
+            "the decay of the peak pressure with depth against the paper's (within 10 %, "
+            "decided here)"))
+    data = {
         "particles": {"rock": len(m["rock"].ids), "charge": len(m["charge"].ids)},
-        "radius_m": m["R"], "dt_s": sim.dt, "steps": sim.steps, "time_s": sim.time,
-        "crater_width_m": common.figure(width, PAPER["crater_width_m"], "m"),
-        "crater_depth_m": common.figure(depth, PAPER["crater_depth_m"], "m"),
-        "P1_start_s": common.figure(start, PAPER["P1_start_s"], "s",
-                                    "first |u_x| > 1 % of its maximum in the first ms"),
+        "radius_m": R, "dt_s": sim.dt, "steps": sim.steps, "time_s": sim.time,
+        "crater": {"width_m": width, "depth_m": depth},
+        "P1_start_s": start,
         "P1_arrivals_s": {"p_wave": dist / c_p, "rayleigh": dist / c_r},
-        "peak_pressure_Pa": {k: common.figure(v, PAPER[k + "_peak_Pa"], "Pa")
-                             for k, v in peaks.items()},
-        "peak_ratio": {k: common.figure(ratio[k], paper_ratio[k]) for k in ratio},
+        "peak_pressure_Pa": peaks,
+        "peak_ratio": ratio,
         "charge_initial_volume_m2": float(st[:, 4].sum()),
         "charge": {"max_relative_volume": float(st[:, 0].max()),
                    "energy_left_fraction": float((st[:, 1] * st[:, 4]).sum()
@@ -233,80 +263,113 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
         "energy_J_per_m": sim.energy(),
         "monitor_particles": mon,
     }
-    summary["pass"] = None   # no pass/fail: the paper's figures are compared, see the note
 
     def plot():
-        plots(snaps, hist, xs, top, out, m)
+        plots(snaps, hist, xs, top, out, m, at_end)
 
-    return _pcmm.finish(summary, out, {CASE: hist}, plot, watch)
+    return _pcmm.finish(CASE, preset, checks, data, out, {CASE: hist}, plot, watch,
+                        threads=threads, paper="Feng, Li & Oñate (2015), §4.2, Figs. 21-24")
 
 
-def plots(snaps, hist, xs, top, out, m):
+def _pressure_panel(fig, ax, x, r, pr, rock, charge):
+    """One Fig. 22 snapshot: rock and explosive particles, each with its own colour
+    scale and colour bar (the products' pressure, thousands of MPa, would leave the
+    rock's hundreds black on a shared scale)."""
+    from mpl_toolkits.axes_grid1 import make_axes_locatable
+    x0, x1, y0, y1 = W / 2 - 2.5, W / 2 + 2.5, 0.3, H + 0.6
+    div = make_axes_locatable(ax)
+    for ids, cmap, label, pad in ((rock, "inferno", "rock\npressure (MPa)", 0.08),
+                                  (charge, "winter", "explosive\npressure (MPa)", 0.75)):
+        sel = ids[(x[ids, 0] > x0) & (x[ids, 0] < x1) & (x[ids, 1] > y0) & (x[ids, 1] < y1)]
+        cax = div.append_axes("right", size="1.5%", pad=pad)
+        if not len(sel):      # keep the panels aligned: an empty colour bar slot
+            cax.axis("off")
+            cax.text(0.0, 0.5, label.replace("\n", " ") + ":\nnone in view", fontsize=7,
+                     rotation=90, va="center", transform=cax.transAxes)
+            continue
+        p = pr[sel] / 1e6
+        top = max(float(np.percentile(p, 99.5)), 1.0)
+        sc = ax.scatter(x[sel, 0], x[sel, 1], c=np.clip(p, 0.0, None), s=3, cmap=cmap,
+                        vmin=0.0, vmax=top, linewidths=0)
+        cb = fig.colorbar(sc, cax=cax)
+        cb.set_label(label, fontsize=7)
+        cb.ax.tick_params(labelsize=7)
+    ax.set_aspect("equal")
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_ylabel("y (m)", fontsize=8)
+    ax.tick_params(labelsize=8)
+
+
+def plots(snaps, hist, xs, top, out, m, at_end=True):
     plt = common.pyplot()
+    rock, charge = np.asarray(m["rock"].ids), np.asarray(m["charge"].ids)
     # Fig. 22: pressure snapshots
-    fig, axes = plt.subplots(len(snaps), 1, figsize=(9, 1.9 * len(snaps) + 0.6), squeeze=False)
+    fig, axes = plt.subplots(len(snaps), 1, figsize=(8, 2.1 * len(snaps) + 0.4),
+                             squeeze=False)
     for ax, (t, x, r, pr) in zip(axes[:, 0], snaps):
-        sel = (np.abs(x[:, 0] - W / 2) < 2.5) & (x[:, 1] > 0.3)
-        sc = ax.scatter(x[sel, 0], x[sel, 1], c=np.clip(pr[sel], 0, None) / 1e6, s=2,
-                        cmap="inferno", vmin=0, vmax=max(np.percentile(pr[sel], 99.5) / 1e6, 1))
-        ax.set_aspect("equal")
-        ax.set_xlim(W / 2 - 2.5, W / 2 + 2.5)
-        ax.set_ylim(0.3, H + 0.6)
+        _pressure_panel(fig, ax, x, r, pr, rock, charge)
         ax.set_title(f"t = {t * 1e3:.2f} ms", fontsize=9)
-        fig.colorbar(sc, ax=ax, label="pressure (MPa)")
+    axes[-1, 0].set_xlabel("x (m)", fontsize=8)
+    fig.suptitle("Contact burst: pressure, compression + (paper Fig. 22); "
+                 "rock and explosive on their own scales", fontsize=10)
     fig.tight_layout()
-    fig.savefig(out / "fig22_pressure.png", dpi=120)
-    plt.close(fig)
+    common.save(fig, out / "fig22_pressure.png", dpi=120)
+    t_end = max(float(np.asarray(hist["P1"][0])[-1]), 0.0) if len(hist["P1"][0]) else 0.0
     # Fig. 23: P1-P3 horizontal displacement
     fig, ax = plt.subplots(figsize=(6, 3.5))
     for k in ("P1", "P2", "P3"):
         t, v = hist[k]
         ax.plot(np.asarray(t) * 1e3, np.asarray(v) * 1e3, label=f"{k} (x = {MONITOR_X[k]} m)")
-    ax.axvline(PAPER["P1_start_s"] * 1e3, color="k", ls=":", label="paper: P1 starts")
+    if common.reached(t_end, PAPER["P1_start_s"]):
+        ax.axvline(PAPER["P1_start_s"] * 1e3, color="k", ls=":",
+                   label=f"paper: P1 starts ({PAPER['P1_start_s'] * 1e3:.2f} ms)")
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("horizontal displacement (mm)")
-    ax.legend()
+    ax.set_title("Contact burst: surface displacement (paper Fig. 23)", fontsize=10)
+    ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out / "fig23_displacement.png", dpi=120)
-    plt.close(fig)
+    common.save(fig, out / "fig23_displacement.png", dpi=120)
     # Fig. 24: P4-P6 pressure
-    fig, ax = plt.subplots(figsize=(6, 3.5))
+    fig, ax = plt.subplots(figsize=(6.5, 3.8))
     for k, col in zip(("P4", "P5", "P6"), ("C0", "C1", "C2")):
         t, v = hist[k]
         ax.plot(np.asarray(t) * 1e3, np.asarray(v) / 1e6, color=col,
                 label=f"{k} (depth {MONITOR_DEPTH[k]} m)")
-        ax.axhline(PAPER[k + "_peak_Pa"] / 1e6, color=col, ls=":", lw=0.8)
+        ax.axhline(PAPER[k + "_peak_Pa"] / 1e6, color=col, ls=":", lw=0.9,
+                   label=f"paper's peak at {k}: {PAPER[k + '_peak_Pa'] / 1e6:.0f} MPa")
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("pressure (MPa)")
-    ax.set_title("dotted: the paper's peaks", fontsize=9)
-    ax.legend()
+    ax.set_title("Contact burst: pressure below the charge (paper Fig. 24)", fontsize=10)
+    ax.legend(fontsize=7, loc="center right")
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out / "fig24_pressure.png", dpi=120)
-    plt.close(fig)
+    common.save(fig, out / "fig24_pressure.png", dpi=120)
     # crater profile
     fig, ax = plt.subplots(figsize=(7, 3))
     sel = np.abs(xs - W / 2) < 1.5
     ax.step(xs[sel], top[sel], where="mid", label="rock surface (particles moved < 2R)")
-    ax.axhline(H, color="k", lw=0.6)
-    ax.axvspan(W / 2 - PAPER["crater_width_m"] / 2, W / 2 + PAPER["crater_width_m"] / 2,
-               color="C3", alpha=0.12, label="paper: crater width")
-    ax.axhline(H - PAPER["crater_depth_m"], color="C3", ls=":", label="paper: crater depth")
+    ax.axhline(H, color="k", lw=0.6, label="initial surface")
+    if at_end:
+        ax.axvspan(W / 2 - PAPER["crater_width_m"] / 2, W / 2 + PAPER["crater_width_m"] / 2,
+                   color="C3", alpha=0.12,
+                   label=f"paper: crater width {PAPER['crater_width_m']} m")
+        ax.axhline(H - PAPER["crater_depth_m"], color="C3", ls=":",
+                   label=f"paper: crater depth {PAPER['crater_depth_m']} m")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
+    ax.set_title(f"Contact burst: crater at t = {t_end * 1e3:.2f} ms", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "crater.png", dpi=120)
-    plt.close(fig)
+    common.save(fig, out / "crater.png", dpi=120)
 
 
 def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
     s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    print(f"summary: {out / 'summary.json'}; crater {s['crater_width_m']['value']:.2f} m wide, "
-          f"{s['crater_depth_m']['value']:.2f} m deep (paper 1.4, 0.35); "
-          f"{s['runtime_s']:.0f} s")
+    common.print_checks(s)
+    print(f"summary: {out / 'summary.json'}")
     return 0
 
 

@@ -266,12 +266,12 @@ def plot_force_vectors(sim, png, title):
     ax.set_ylim(-4.2 * R, 4.2 * R)
     c = 0.5 * (p["position"][CENTRE] + p["position"][UPPER])
     ax.annotate("C", c + np.array([0.35 * R, 0.0]), fontsize=11, color="tab:red")
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_title(f"{title}\n(bar width ∝ contact force; widest = {fmax:.3g})", fontsize=10)
+    ax.set_xlabel("x (C&S length units)")
+    ax.set_ylabel("y (C&S length units)")
+    ax.set_title(f"{title}\n(bar width ∝ contact force; widest = {fmax:.3g} C&S force units)",
+                 fontsize=10)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_fig6(undamped, damped, f_eq, png):
@@ -283,14 +283,13 @@ def plot_fig6(undamped, damped, f_eq, png):
     ax.plot(damped.cycles, damped.fn, color="tab:red", lw=1.5,
             label="2: contact + global damping")
     ax.axhline(f_eq, color="k", ls="--", lw=1.0, label=f"$F_{{eq}}$ = {f_eq:.4g}")
-    ax.set_xlabel("calculation cycles")
-    ax.set_ylabel("normal force at C")
+    ax.set_xlabel("calculation cycles (time steps)")
+    ax.set_ylabel("normal force at C (C&S force units)")
     ax.set_title("Nine-disc test: damping effects (C&S Fig. 6)")
     ax.legend(loc="lower right", fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_fig7(panels, png):
@@ -299,16 +298,16 @@ def plot_fig7(panels, png):
     for ax, (title, runs) in zip(axes[:, 0], panels):
         for (label, run), color in zip(runs, ("tab:blue", "tab:orange")):
             ax.plot(run.cycles, run.fn, color=color, lw=1.0, label=label)
-            ax.axvline(run.load_cycles, color=color, ls=":", lw=0.8)
-        ax.set_xlabel("calculation cycles")
-        ax.set_ylabel("normal force at C")
+            ax.axvline(run.load_cycles, color=color, ls=":", lw=0.8,
+                       label=f"{label.split(':')[0]}: walls stop")
+        ax.set_xlabel("calculation cycles (time steps)")
+        ax.set_ylabel("normal force at C\n(C&S force units)")
         ax.set_title(title, fontsize=10)
         ax.legend(fontsize=8, loc="lower right")
         ax.grid(alpha=0.3)
     fig.suptitle("Nine-disc test: speed of loading, no damping (C&S Fig. 7)")
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_fig9(runs, png):
@@ -326,16 +325,15 @@ def plot_fig9(runs, png):
         ax.axvline(start, color="0.5", lw=0.8, ls=":")
         ax.annotate("distortion starts", (start, ax.get_ylim()[1]), fontsize=8,
                     ha="left", va="top", xytext=(4, -4), textcoords="offset points")
-        ax.set_xlabel("calculation cycles")
-        ax.set_ylabel("force at C")
+        ax.set_xlabel("calculation cycles (time steps)")
+        ax.set_ylabel("force at C (C&S force units)")
         ax.set_title(f"$\\phi_\\mu$ = {phi:g}°", fontsize=10)
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
         ax.grid(alpha=0.3)
     fig.suptitle("Nine-disc test: effect of $k_s/k_n$ and $\\phi_\\mu$ under "
                  "constant-volume distortion (C&S Fig. 9)")
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_sweep(fracs, ratios, png):
@@ -344,14 +342,13 @@ def plot_sweep(fracs, ratios, png):
     ax.plot(fracs, ratios, "o-")
     ax.axhline(0.15, color="k", ls="--", lw=1, label="C&S: about 0.15")
     ax.axvline(DT_FRACTION, color="tab:red", ls=":", label=f"used: {DT_FRACTION}")
-    ax.set_xlabel("time step / critical time step 2√(m/k)")
-    ax.set_ylabel("oscillation amplitude / $F_{eq}$")
+    ax.set_xlabel("time step / critical time step 2√(m/k) (–)")
+    ax.set_ylabel("oscillation amplitude / $F_{eq}$ (–)")
     ax.set_title("Nine-disc test, no damping: amplitude after 40 loading cycles", fontsize=10)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 # ------------------------------------------------------------------- the case
@@ -372,37 +369,44 @@ def fig9_outcome(runs):
             "slips_at_C": bool(np.any(np.abs(s) >= 0.999 * mu * np.abs(d))),
             "wall_rotation_rad": r.theta, "area_change": r.area_change,
         }
-    figs = {}
+    figs = []
+    dev15 = None
     if (15.0, 0.667) in by and (15.0, 1.0) in by:
         a, b = by[(15.0, 0.667)], by[(15.0, 1.0)]
         n = min(len(a.fn), len(b.fn))
-        dev = float(np.max(np.abs(a.fn[:n] - b.fn[:n])) / np.max(a.fn[:n]))
-        figs["phi15_max_difference_Fn"] = common.figure(
-            dev, "small", "fraction of max F_n",
-            "C&S Fig. 9a: the curves for k_s/k_n = 2/3 and 1 nearly coincide at 15°")
+        dev15 = float(np.max(np.abs(a.fn[:n] - b.fn[:n])) / np.max(a.fn[:n]))
+        figs.append(common.check(
+            "phi15_max_difference_Fn", dev15, None, common.between(max=0.05),
+            "",
+            "C&S Fig. 9a: the curves for k_s/k_n = 2/3 and 1 nearly coincide at 15°; "
+            "'nearly coincide' read here as within 5 % of the largest F_n"))
     if (30.0, 0.667) in by and (30.0, 1.0) in by:
         a, b = by[(30.0, 0.667)], by[(30.0, 1.0)]
         n = min(len(a.fn), len(b.fn))
         dev = float(np.max(np.abs(a.fn[:n] - b.fn[:n])) / np.max(a.fn[:n]))
-        figs["phi30_max_difference_Fn"] = common.figure(
-            dev, "significant (larger than at 15°)", "fraction of max F_n",
-            "C&S Fig. 9b: the curves deviate significantly at 30°")
-        figs["phi30_Fn_start_lower_for_ks_eq_kn"] = common.figure(
-            bool(b.fn_start < a.fn_start), True, "",
+        figs.append(common.check(
+            "phi30_max_difference_Fn", dev, None,
+            common.between(min=dev15) if dev15 is not None else None, "",
+            "C&S Fig. 9b: the curves deviate significantly at 30°: more than at 15° "
+            "(the lower bound is the 15° difference)"))
+        figs.append(common.check(
+            "phi30_Fn_start_lower_for_ks_eq_kn", bool(b.fn_start < a.fn_start), True,
+            common.EQUAL, "",
             f"undistorted compression: F_n(k_s/k_n=1) = {b.fn_start:.4g}, "
-            f"F_n(2/3) = {a.fn_start:.4g}; C&S: lower for the higher shear stiffness")
+            f"F_n(2/3) = {a.fn_start:.4g}; C&S: lower for the higher shear stiffness"))
         sa, sb = a.cycles > a.start, b.cycles > b.start
         overtakes = bool(np.any(b.fn[sb][:n] > a.fn[sa][:n])) if n else False
         ib = int(np.argmax(b.fn[sb]))
         falls = bool(b.fn[sb][-1] < (1.0 - 1e-3) * b.fn[sb][ib])
-        figs["phi30_ks_eq_kn_overtakes_then_falls_back"] = common.figure(
-            bool(overtakes and falls), True, "",
+        figs.append(common.check(
+            "phi30_ks_eq_kn_overtakes_then_falls_back", bool(overtakes and falls), True,
+            common.EQUAL, "",
             "C&S: under shearing F_n for k_s/k_n = 1 rises above the curve for 2/3 to a "
             f"maximum (theirs 25.6e8, ours {b.fn[sb][ib]:.4g} at cycle {b.cycles[sb][ib]}), "
             "then slip sets in and it falls back; overtakes="
             f"{overtakes}, falls back={falls}. Force magnitudes scale with the reading of "
             "the wall speed (module docstring) and the amount of distortion, which C&S "
-            "do not give")
+            "do not give"))
     return figs, out
 
 
@@ -421,7 +425,11 @@ def main(argv=None):
     plot_force_vectors(damped.sim, out / "fig5b_force_vectors.png",
                        "Nine discs after compression at equilibrium (C&S Fig. 5b)")
     common.plot_histories(damped.sim, out / "monitors.png",
-                          title="Nine-disc test, damped compression: force at C [F_n, F_s]")
+                          title="Nine-disc test, damped compression: force at contact C",
+                          names={"force_C": "force at C"},
+                          components={"force_C": ["normal force $F_n$", "shear force $F_s$"]},
+                          units={"force_C": "C&S force units"},
+                          time_label="time (C&S time units)")
     # (a) undamped; (c) Fig. 7 slow runs; smooth variant for the closed form r = 0
     undamped = compression(0.12, hold=hold, name="undamped", **opts)
     slow = compression(0.04, load_cycles=3 * LOAD_CYCLES, hold=hold, name="slow", **opts)
@@ -470,43 +478,47 @@ def main(argv=None):
 
     common.save_histories(out / "histories.h5", {r.name: r.sim.histories() for r in runs})
 
-    figures = {
-        "undamped_amplitude_over_F_eq": common.figure(
-            amp_u / f_eq, 0.15, "",
-            "C&S Fig. 6 curve 1: amplitude about 0.15 F_eq. Half the peak-to-peak range "
-            f"after the walls stop ({hold} cycles). It depends on dt (module docstring)"),
-        "undamped_mean_over_F_eq": common.figure(
-            mean_u / f_eq, 1.0, "", "the undamped force oscillates about F_eq"),
-        "damped_final_over_F_eq_from_undamped_mean": common.figure(
-            f_eq / mean_u, 1.0, "",
-            "C&S: damping does not change the equilibrium value; target within 2 %. "
+    checks = [
+        common.check(
+            "undamped_amplitude_over_F_eq", amp_u / f_eq, 0.15, common.rel(0.10), "",
+            "C&S Fig. 6 curve 1: amplitude about 0.15 F_eq (tolerance decided here: 10 %). "
+            f"Half the peak-to-peak range after the walls stop ({hold} cycles). It is set "
+            f"by dt: {DT_FRACTION} of the critical step here, which C&S do not give "
+            "(module docstring; the paper preset's dt_sweep.png)"),
+        common.check(
+            "undamped_mean_over_F_eq", mean_u / f_eq, 1.0, common.rel(0.02), "",
+            "the undamped force oscillates about F_eq (within 2 %)"),
+        common.check(
+            "damped_final_over_F_eq_from_undamped_mean", f_eq / mean_u, 1.0,
+            common.rel(0.02), "",
+            "C&S: damping does not change the equilibrium value (within 2 %). "
             "F_eq (reference) = final force of the damped run"),
-        "F_eq": common.figure(f_eq, f_closed, "force",
-                              "damped run at the end, against the closed form "
-                              "(6/7) k_n delta / 2 for k_s = k_n without slip"),
-        "F_eq_smooth": common.figure(
-            float(smooth.fn[-1]), f_smooth_closed, "force",
+        common.check(
+            "F_eq", f_eq, f_closed, common.rel(0.01), "C&S force units",
+            "damped run at the end, against the closed form (6/7) k_n delta / 2 for "
+            "k_s = k_n without slip (within 1 %)"),
+        common.check(
+            "F_eq_smooth", float(smooth.fn[-1]), f_smooth_closed, common.rel(0.01),
+            "C&S force units",
             "frictionless discs and walls (normal forces only), damped: closed form "
-            "k_n delta / 2, delta = v 40 dt"),
-        "fig7a_amplitude_ratio_fast_over_slow": common.figure(
-            amp_u / amp_s, "> 1 (C&S: much larger)", "",
-            f"v = 0.12 for 40 cycles vs 0.04 for 120: amplitudes {amp_u:.4g} / {amp_s:.4g}; "
-            f"equilibrium forces {mean_u:.4g} / {mean_s:.4g}"),
-    }
+            "k_n delta / 2, delta = v 40 dt (within 1 %)"),
+        common.check(
+            "fig7a_amplitude_ratio_fast_over_slow", amp_u / amp_s, None,
+            common.between(min=1.0), "",
+            f"C&S: much larger after fast loading. v = 0.12 for 40 cycles vs 0.04 for 120: "
+            f"amplitudes {amp_u:.4g} / {amp_s:.4g}; equilibrium forces "
+            f"{mean_u:.4g} / {mean_s:.4g}"),
+    ]
     if cfg["fig7b"]:
         mb, ab = oscillation(fast_b)
         msb, asb = oscillation(slow_b)
-        figures["fig7b_amplitude_ratio_fast_over_slow"] = common.figure(
-            ab / asb, "> 1", "",
-            f"k = 1.5e8, v = 0.36 for 40 cycles vs 0.12 for 120: equilibrium forces "
-            f"{mb:.4g} / {msb:.4g} (Fig. 7a: {mean_u:.4g})")
-    figures.update(fig9_figs)
+        checks.append(common.check(
+            "fig7b_amplitude_ratio_fast_over_slow", ab / asb, None, common.between(min=1.0),
+            "", f"k = 1.5e8, v = 0.36 for 40 cycles vs 0.12 for 120: equilibrium forces "
+                f"{mb:.4g} / {msb:.4g} (Fig. 7a: {mean_u:.4g})"))
+    checks += fig9_figs
 
-    summary = {
-        "case": CASE,
-        "preset": args.preset,
-        "paper": "Cundall & Strack (1979), Geotechnique 29(1), nine-disc test, Figs. 5-9",
-        "figures": figures,
+    data = {
         "fig9": fig9_table,
         "parameters": {
             "radius": R, "density": DENSITY, "kn": KN, "ks_over_kn": 1.0,
@@ -518,13 +530,17 @@ def main(argv=None):
             "distortion_rotation_rad": theta, "distortion_cycles": ncyc,
         },
         "dt_sweep": sweep,
-        "runtime_s": clock(),
     }
+    summary = common.summary(
+        CASE, args.preset, checks, data, clock(), threads=args.threads,
+        paper="Cundall & Strack (1979), Geotechnique 29(1), nine-disc test, Figs. 5-9",
+        notes="C&S's units have no physical meaning: forces, lengths and times are plain "
+              "numbers ('C&S units')")
     common.write_summary(out, summary)
     print(f"nine_disc ({args.preset}): F_eq = {f_eq:.5g} (closed form {f_closed:.5g}); "
           f"undamped amplitude/F_eq = {amp_u / f_eq:.3f} (C&S ~0.15); undamped mean/F_eq = "
-          f"{mean_u / f_eq:.4f}; fast/slow amplitude = {amp_u / amp_s:.2f}; "
-          f"{clock():.1f} s -> {out}")
+          f"{mean_u / f_eq:.4f}; fast/slow amplitude = {amp_u / amp_s:.2f} -> {out}")
+    common.print_checks(summary)
     return summary
 
 

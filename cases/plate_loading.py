@@ -221,8 +221,7 @@ def plot_settlement(results, png):
     ax.set_title("Stress against settlement (Miyata Fig. 26)")
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_shares(results, png):
@@ -238,11 +237,8 @@ def plot_shares(results, png):
         ax.bar(xs, load, w, color=colors[k], label=f"{name}: share of load")
         ax.scatter(xs, count, marker="_", s=250, color="k", zorder=3,
                    label="share of contacts" if k == 0 else None)
-    ax.axhline(20, color="tab:green", ls=":", lw=1)
-    ax.text(-0.45, 21, "paper: final ≤ 20 %", ha="left", fontsize=8, color="tab:green")
-    ax.axhline(70, color="0.4", ls=":", lw=1)
-    ax.text(-0.45, 71, "paper: initial + transition > 70 %", ha="left", fontsize=8,
-            color="0.3")
+    ax.axhline(20, color="tab:green", ls=":", lw=1, label="paper: final ≤ 20 %")
+    ax.axhline(70, color="0.4", ls=":", lw=1, label="paper: initial + transition > 70 %")
     ax.set_xticks(np.arange(len(beds)), beds)
     ax.set_ylabel("share at 900 kPa (%)")
     ax.set_ylim(0, 100)
@@ -253,8 +249,7 @@ def plot_shares(results, png):
               frameon=False)
     ax.grid(alpha=0.3, axis="y")
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def plot_chains(results, png):
@@ -303,8 +298,7 @@ def plot_chains(results, png):
     fig.suptitle("Force chains at 900 kPa (line width ∝ normal force; Miyata Fig. 27)",
                  y=0.995)
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    common.save(fig, png)
 
 
 def main(argv=None):
@@ -337,22 +331,23 @@ def main(argv=None):
         for b, r in results.items()})
 
     checks = []
-
-    def check(name, value, op, bound, note=""):
-        ok = {"<": value < bound, "<=": value <= bound, ">": value > bound}[op]
-        checks.append({"name": name, "value": float(value), "target": f"{op} {bound}",
-                       "unit": "fraction", "pass": bool(ok), "note": note})
-
     beds = {}
     for bed, r in results.items():
         ls = r["load_share"]
-        check(f"{bed} load share, initial + transition", ls[0] + ls[1], ">", 0.70,
-              "Miyata: over 70 % of the 900 kPa load")
-        check(f"{bed} load share, final", ls[2], "<=", 0.20, "Miyata: 20 % or less")
+        checks += [
+            common.check(f"{bed}.load_share_initial_transition", ls[0] + ls[1], None,
+                         common.between(min=0.70), "",
+                         "Miyata: over 70 % of the 900 kPa load"),
+            common.check(f"{bed}.load_share_final", ls[2], None, common.between(max=0.20), "",
+                         "Miyata: 20 % or less"),
+        ]
         if bed[0] == "S":
-            check(f"{bed} load share, initial", ls[0], ">", 0.50, "Miyata (SS, SR): over 50 %")
-            check(f"{bed} load share, final (square)", ls[2], "<", 0.15,
-                  "Miyata (SS, SR): under 15 %")
+            checks += [
+                common.check(f"{bed}.load_share_initial", ls[0], None,
+                             common.between(min=0.50), "", "Miyata (SS, SR): over 50 %"),
+                common.check(f"{bed}.load_share_final_square", ls[2], None,
+                             common.between(max=0.15), "", "Miyata (SS, SR): under 15 %"),
+            ]
         h = r["history"]
         beds[bed] = {
             "particles": r["n"],
@@ -366,14 +361,11 @@ def main(argv=None):
             "kinetic_energy_over_plate_work": r["kinetic_over_work"],
             "nonconverged_contacts": r["nonconverged"],
         }
-    summary = {
-        "case": CASE, "preset": args.preset, "runtime_s": clock(),
-        "plate_speed_m_s": cfg["speed"], "checks": checks,
-        "pass": all(c["pass"] for c in checks), "beds": beds,
-    }
+    summary = common.summary(
+        CASE, args.preset, checks, {"plate_speed_m_s": cfg["speed"], "beds": beds}, clock(),
+        threads=args.threads, paper="Miyata et al. (2002), §3.2, Figs. 26-30")
     common.write_summary(out, summary)
-    print(f"{CASE}: {sum(c['pass'] for c in checks)}/{len(checks)} of the paper's statements "
-          f"hold; {out / 'summary.json'}")
+    common.print_checks(summary)
     return summary
 
 

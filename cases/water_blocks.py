@@ -250,13 +250,18 @@ def _draw(ax, snap, prange):
     ax.set_xlim(-0.05, TANK_L + 0.05)
     ax.set_ylim(-0.05, WATER_H * 1.05)
     ax.set_aspect("equal")
-    ax.set_title(f"t = {snap['t']:.2f} s (paper {snap['paper_t']:.2f} s)", fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.set_xlabel("x (m)", fontsize=7)
+    ax.set_ylabel("y (m)", fontsize=7)
+    when = (" (a time of the paper's snapshots)" if snap["paper_t"] is not None
+            else " (no paper snapshot: its later ones lie beyond this run)")
+    ax.set_title(f"t = {snap['t']:.2f} s{when}", fontsize=8)
     return sc
 
 
 def plot_snapshots(snaps, png, title):
     plt = common.pyplot()
-    fig, axes = plt.subplots(3, 2, figsize=(10, 8))
+    fig, axes = plt.subplots(3, 2, figsize=(9, 6.4), layout="constrained")
     prange = (0.0, RHO_W * 9.81 * WATER_H)
     sc = None
     for ax, snap in zip(axes.ravel(), snaps):
@@ -265,9 +270,8 @@ def plot_snapshots(snaps, png, title):
         ax.axis("off")
     if sc is not None:
         fig.colorbar(sc, ax=axes.ravel().tolist(), label="water pressure (kPa)", shrink=0.6)
-    fig.suptitle(title)
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
+    fig.suptitle(title, fontsize=10)
+    common.save(fig, png, dpi=110)
 
 
 def plot_displacements(results, png):
@@ -276,18 +280,23 @@ def plot_displacements(results, png):
     for name, res in results.items():
         t, dx, rot = res["t"], res["dx_top"], res["rot_top"]
         axes[0].plot(t, dx, label=f"{name} columns: top block, right column")
-        axes[1].plot(t, rot, label=f"{name} columns")
-    axes[0].axhline(TOPPLED_DX, color="r", ls=":", lw=0.8)
-    axes[0].axhline(STOOD_DX, color="g", ls=":", lw=0.8)
+        axes[1].plot(t, rot, label=f"{name} columns: top block, right column")
+    axes[0].axhline(TOPPLED_DX, color="r", ls=":", lw=0.8,
+                    label=f"|dx| > {TOPPLED_DX} m: slid (if not toppled)")
+    axes[0].axhline(STOOD_DX, color="g", ls=":", lw=0.8, label=f"|dx| < {STOOD_DX} m: stood")
+    axes[1].axhline(TOPPLED_ROT, color="r", ls=":", lw=0.8,
+                    label=f"|rotation| > {TOPPLED_ROT:g}°: toppled")
+    axes[1].axhline(STOOD_ROT, color="g", ls=":", lw=0.8,
+                    label=f"|rotation| < {STOOD_ROT:g}°: stood")
     axes[0].set_ylabel("horizontal displacement (m)")
-    axes[1].set_ylabel("rotation (deg, ccw +)")
+    axes[1].set_ylabel("rotation (°, counter-clockwise +)")
     for ax in axes:
         ax.set_xlabel("time after the board is removed (s)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
+    fig.suptitle("Water and blocks: top block of the rightmost column", fontsize=10)
     fig.tight_layout()
-    fig.savefig(png, dpi=120)
-    plt.close(fig)
+    common.save(fig, png, dpi=120)
 
 
 def run_one(cfg, columns, name, out, arch=None, threads=None):
@@ -333,7 +342,8 @@ def run_one(cfg, columns, name, out, arch=None, threads=None):
         if any(abs(tc - s) < 1e-6 for s in snap_t):
             k = snap_t.index(min(snap_t, key=lambda s: abs(s - tc)))
             ids = m["water"].ids
-            snaps.append({"t": sim.time - t0, "paper_t": paper_t[k],
+            at_paper = k < len(paper_t) and abs(snap_t[k] - paper_t[k]) < 1e-6
+            snaps.append({"t": sim.time - t0, "paper_t": paper_t[k] if at_paper else None,
                           "x": p["position"][ids].copy(), "r": p["radius"][ids].copy(),
                           "p": p["pressure"][ids].copy(),
                           "blocks": [b.nodes()["position"][[0, 1, 2, 3]].copy() for b in blocks]})
@@ -368,41 +378,51 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
         plot_snapshots(r["snaps"], out / fig,
                        f"Water and {name}-column block system ({preset} preset; paper Fig. "
                        f"{26 if name == 'four' else 27})")
-    figures = {}
+    checks = []
+    c = math.sqrt(cfg["bulk"] / RHO_W)
+    rise_bound = BLOCK * (1.0 + (math.sqrt(2.0) - 1.0) / 2.0)
     for name, r in results.items():
         dx = float(r["dx_top"][-1]) if len(r["dx_top"]) else float("nan")
-        rot = float(r["rot_top"][-1]) if len(r["rot_top"]) else float("nan")
         dxm = float(np.max(np.abs(r["dx_top"]))) if len(r["dx_top"]) else float("nan")
         rotm = float(np.max(np.abs(r["rot_top"]))) if len(r["rot_top"]) else float("nan")
         outcome = classify(dxm, rotm)
-        figures[f"{name}_outcome"] = common.figure(
-            outcome, PAPER_OUTCOME[name], "",
-            f"top block of the rightmost column: toppled if |rotation| > {TOPPLED_ROT} deg, "
-            f"slid if not but |dx| > {TOPPLED_DX} m, stood if |dx| < {STOOD_DX} m and "
-            f"|rotation| < {STOOD_ROT} deg (largest values over the run), else moved")
         moving = np.flatnonzero(np.abs(r["dx_top"]) > 0.005)
-        figures[f"{name}_motion_onset"] = common.figure(
-            float(r["t"][moving[0]]) if len(moving) else None, 0.40, "s",
-            "first time the top block of the rightmost column moved 5 mm; target: the "
-            "dam-break front's arrival (Martin & Moyce, x/a = 2.44 at T = 2.0); the paper's "
-            "Fig. 26a shows the water at the blocks at 0.36 s")
-        figures[f"{name}_top_dx_final"] = common.figure(dx, None, "m", "at the end of the run")
-        figures[f"{name}_top_dx_max"] = common.figure(dxm, None, "m", "largest |dx|")
-        figures[f"{name}_top_rotation_max"] = common.figure(rotm, None, "deg", "largest |rotation|")
-        figures[f"{name}_block_rise_max"] = common.figure(
-            float(np.max(r["rise"])) if len(r["rise"]) else None, None, "m",
-            "largest rise of any block's centre above its start (riding onto another "
-            "block and tipping over a corner raise it by at most 0.1 m + (sqrt(2) - 1)/2 x "
-            "0.1 m = 0.121 m; more: a block thrown up)")
-        figures[f"{name}_water_right_of_blocks"] = common.figure(
-            r["water_right_of_blocks"], None, "",
-            "fraction of water particles right of the blocks at the end")
-        figures[f"{name}_water_vmax"] = common.figure(
-            float(np.max(r["vmax_water"])) if len(r["vmax_water"]) else None, None, "m/s",
-            "largest water particle speed (c must stay >= 10 x this)")
-    c = math.sqrt(cfg["bulk"] / RHO_W)
-    summary = {
-        "case": CASE, "preset": preset,
+        checks += [
+            common.check(
+                f"{name}.outcome", outcome, PAPER_OUTCOME[name], common.EQUAL, "",
+                f"top block of the rightmost column: toppled if |rotation| > {TOPPLED_ROT}°, "
+                f"slid if not but |dx| > {TOPPLED_DX} m, stood if |dx| < {STOOD_DX} m and "
+                f"|rotation| < {STOOD_ROT}° (largest values over the run), else moved; "
+                f"paper Fig. {26 if name == 'four' else 27}"),
+            common.check(
+                f"{name}.motion_onset", float(r["t"][moving[0]]) if len(moving) else None, None,
+                common.between(0.40, 0.60), "s",
+                "first time the top block of the rightmost column moved 5 mm: after the "
+                "dam-break front's arrival at the blocks (Martin & Moyce, x/a = 2.44 at "
+                "T = 2.0: 0.40 s; the paper's Fig. 26a shows the water there at 0.36 s), "
+                "before 0.60 s (decided here: the surge builds up its push within 0.2 s)"),
+            common.check(
+                f"{name}.block_rise_max", float(np.max(r["rise"])) if len(r["rise"]) else None,
+                None, common.between(max=rise_bound), "m",
+                "largest rise of any block's centre above its start: riding onto another "
+                "block and tipping over a corner raise it by at most 0.1 m + (sqrt(2) - 1)/2 "
+                "x 0.1 m = 0.121 m; more would be a block thrown up"),
+            common.check(
+                f"{name}.water_vmax", float(np.max(r["vmax_water"])) if len(r["vmax_water"])
+                else None, None, common.between(max=c / 10.0), "m/s",
+                f"largest water particle speed; weakly compressible water needs c >= 10 x "
+                f"the largest flow speed (spec PHYSICS.md), c = {c:.0f} m/s"),
+            common.check(f"{name}.top_dx_max", dxm, None, None, "m",
+                         "largest |dx| of the top block of the rightmost column"),
+            common.check(f"{name}.top_rotation_max", rotm, None, None, "deg",
+                         "largest |rotation| of the top block of the rightmost column"),
+            common.check(f"{name}.top_dx_final", dx, None, None, "m", "at the end of the run"),
+            common.check(f"{name}.water_right_of_blocks", r["water_right_of_blocks"], None,
+                         None, "", "fraction of water particles right of the blocks at the "
+                                   "end (the paper's two-column run: the water fills the "
+                                   "bottom of the tank)"),
+        ]
+    data = {
         "model": {"water_particles": {k: r["n"] for k, r in results.items()},
                   "paper_water_particles": 5528, "packing": cfg["packing"],
                   "bulk_modulus_Pa": cfg["bulk"], "sound_speed_m_s": c,
@@ -411,11 +431,12 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
                   "dt_s": {k: r["dt"] for k, r in results.items()},
                   "settle_s": cfg["settle"], "duration_s": cfg["duration"],
                   "status": {k: r["status"] for k, r in results.items()}},
-        "figures": figures,
-        "notes": ("weakly compressible water (K stated in model); rigid blocks; times from "
-                  "the board's removal; outcome measure in the figure notes"),
-        "runtime_s": clock(),
     }
+    summary = common.summary(
+        CASE, preset, checks, data, clock(), threads=threads,
+        paper="Feng, Li & Oñate (2015), §4.3, Figs. 25-27",
+        notes="weakly compressible water (K in data.model); rigid blocks; times from the "
+              "board's removal; the outcome measure is in the checks' notes")
     common.write_summary(out, summary)
     return summary
 
@@ -423,12 +444,8 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
 def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
     s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    f = s["figures"]
-    for name in ("four", "two"):
-        if f"{name}_outcome" in f:
-            print(f"{name} columns: {f[name + '_outcome']['value']} (paper "
-                  f"{PAPER_OUTCOME[name]}), top block dx max {f[name + '_top_dx_max']['value']} m")
-    print(f"summary: {out / 'summary.json'}; {s['runtime_s']:.0f} s")
+    common.print_checks(s)
+    print(f"summary: {out / 'summary.json'}")
     return 0
 
 

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from cases import _common as common
 from tdem import cli
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -45,16 +46,19 @@ def test_photoelastic_quick(tmp_path):
     out = tmp_path / "pe"
     assert cli.main(["run", "photoelastic", "--preset", "quick", "--out", str(out)]) == 0
     s = _summary(out)
-    ratio = s["figures"]["F_H_over_F_V"]
+    assert common.validate(s) == []
+    ratio = common.checks_by_name(s)["F_H_over_F_V"]
     assert ratio["target"] == pytest.approx(0.39)
+    assert ratio["tolerance"] == {"rel": 0.05}
     assert abs(ratio["value"] - 0.39) <= 0.1
-    walls = s["table1"]["stage_A"]["walls"]
+    table = s["data"]["table1"]["stage_A"]
+    walls = table["walls"]
     assert len(walls) == 4
     for w in walls:
         assert {"F1", "F2", "e_over_half_L_percent"} <= set(w)
     # equilibrium of the walls' forces (the discs are at rest)
-    assert abs(sum(w["F1"] for w in walls)) < 0.01 * s["table1"]["stage_A"]["F_V"]
-    assert abs(sum(w["F2"] for w in walls)) < 0.01 * s["table1"]["stage_A"]["F_V"]
+    assert abs(sum(w["F1"] for w in walls)) < 0.01 * table["F_V"]
+    assert abs(sum(w["F2"] for w in walls)) < 0.01 * table["F_V"]
     assert (out / "fig11_force_vectors.png").stat().st_size > 0
     assert list(out.glob("*.pvd"))
 
@@ -63,12 +67,17 @@ def test_nine_disc_quick(tmp_path):
     out = tmp_path / "nd"
     assert cli.main(["run", "nine_disc", "--preset", "quick", "--out", str(out)]) == 0
     s = _summary(out)
-    for fig in s["figures"].values():
-        assert {"value", "target", "unit", "note"} <= set(fig)
-    amp = s["figures"]["undamped_amplitude_over_F_eq"]["value"]
+    assert common.validate(s) == []
+    c = common.checks_by_name(s)
+    amp = c["undamped_amplitude_over_F_eq"]["value"]
     assert 0.02 <= amp <= 0.25   # C&S about 0.15; set by dt (cases.nine_disc docstring)
-    assert abs(s["figures"]["damped_final_over_F_eq_from_undamped_mean"]["value"] - 1) < 0.02
-    assert s["figures"]["fig7a_amplitude_ratio_fast_over_slow"]["value"] > 1
+    assert c["undamped_amplitude_over_F_eq"]["target"] == pytest.approx(0.15)
+    assert abs(c["damped_final_over_F_eq_from_undamped_mean"]["value"] - 1) < 0.02
+    assert c["damped_final_over_F_eq_from_undamped_mean"]["pass"] is True
+    assert c["fig7a_amplitude_ratio_fast_over_slow"]["value"] > 1
+    # the closed forms of the module docstring, within 1 %
+    for name in ("F_eq", "F_eq_smooth"):
+        assert c[name]["value"] == pytest.approx(c[name]["target"], rel=0.01), name
     for png in ("fig5b_force_vectors.png", "fig6_damping.png", "fig7_loading_speed.png",
                 "fig9_distortion.png"):
         assert (out / png).stat().st_size > 0

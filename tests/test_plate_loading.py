@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 
+from cases import _common as common
 from cases import plate_loading as pl
 
 
@@ -27,9 +28,13 @@ def test_a_contact_keeps_the_state_it_formed_in_until_it_opens():
 def test_quick_preset_reports_the_load_shares(tmp_path):
     pl.main(["--preset", "quick", "--out", str(tmp_path), "--threads", "2"])
     s = json.loads((tmp_path / "summary.json").read_text())
-    for bed, b in s["beds"].items():
+    assert common.validate(s) == []
+    for bed, b in s["data"]["beds"].items():
         shares = list(b["load_share"].values())
         assert sum(shares) == pytest.approx(1.0, abs=1e-9)
         assert 250 <= b["particles"] <= 370
         assert b["nonconverged_contacts"] == 0
+        c = common.checks_by_name(s)[f"{bed}.load_share_final"]
+        assert c["value"] == pytest.approx(b["load_share"]["final"])
+        assert c["tolerance"] == {"max": 0.20}
     assert len(s["checks"]) == 12
