@@ -102,12 +102,18 @@ def measure(sim, box=None, circle=None, polygon=None):
     point = np.concatenate([s[2] for s in sides])
     normal = np.concatenate([n[own], n[other]])
     arm = point - p["position"][owner]
+    if any(q is not None for q in getattr(sim, "_periodic", ())):
+        arm = sim._image(arm)       # the contact point seen from the owner's side
     s = np.einsum("ca,cb->ab", arm, force)
     stress = 0.5 * (s + s.T) / region.area
     npart = int(inside.sum())
     ncont = len(owner)
     fabric = (np.einsum("ca,cb->ab", normal, normal) / ncont) if ncont else np.zeros((2, 2))
-    solid = float(np.sum(math.pi * p["radius"][inside] ** 2))
+    area = math.pi * p["radius"] ** 2
+    if sim._n and sim._has_shapes:
+        rows = np.concatenate(sim._host["shape"])
+        area = np.where(rows[:, 2] > 0, rows[:, 3], area)     # a shape's own area
+    solid = float(np.sum(area[inside]))
     return {"stress": stress, "porosity": 1.0 - solid / region.area,
             "coordination": ncont / npart if npart else 0.0, "fabric": fabric,
             "particles": npart, "contacts": ncont, "area": region.area}

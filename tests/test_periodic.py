@@ -166,3 +166,43 @@ def test_a_periodic_model_of_shapes_restarts_exactly_from_a_checkpoint(tmp_path)
     a, b = sim.particles.numpy(), again.particles.numpy()
     for k in ("position", "velocity", "omega", "angle", "displacement"):
         np.testing.assert_array_equal(a[k], b[k])
+
+
+def test_a_periodic_pack_carries_its_wall_stress_across_the_boundary():
+    """Discs in a box periodic along x, compressed between a floor and a lid and left
+    to rest: the Love–Weber stress over one period (contacts across the boundary
+    counted with the image's branch vector) gives the traction on the lid, (σ_xy, σ_yy)
+    = −(force received by the lid)/width, within 2 % of σ_yy. Superellipses mixed in:
+    the porosity counts their own areas."""
+    rng = np.random.default_rng(4)
+    W = 0.4
+    sim = tdem.Simulation(gravity=(0.0, 0.0), local_damping=0.7)
+    sim.periodic(x=(0.0, W))
+    law = tdem.LinearContact(kn=1e6, ks=1e6, friction=0.3)
+    g = (np.arange(16) + 0.5) * W / 16
+    pos = np.stack(np.meshgrid(g, 0.03 + np.arange(12) * 0.025), -1).reshape(-1, 2)
+    shaped = rng.random(len(pos)) < 0.3
+    pos += rng.uniform(-0.002, 0.002, pos.shape)
+    sim.add_particles(pos[~shaped], rng.uniform(0.0095, 0.0115, int((~shaped).sum())),
+                      density=1000.0, contact=law)
+    shape = tdem.Superellipse(0.012, 0.008, 4)
+    sim.add_particles(pos[shaped], shape=shape, angle=rng.uniform(0, 360, int(shaped.sum())),
+                      density=1000.0, contact=law)
+    sim.add_wall((-0.1, 0.0), (W + 0.1, 0.0), contact=law)
+    lid = sim.add_wall((W + 0.1, 0.33), (-0.1, 0.33), contact=law, velocity=(0.0, -0.1))
+    while True:
+        sim.run(steps=200)
+        if abs(lid.force[1]) / W > 2e4:
+            break
+    lid.velocity = (0.0, 0.0)
+    sim.run(until=sim.time + 0.5)
+    top = lid.endpoints[0][1]
+    m = sim.measure(box=((0.0, 0.0), (W, top)))
+    sxy, syy = -lid.force[0] / W, -lid.force[1] / W
+    assert syy < -1e4
+    assert m["particles"] == sim.n_particles
+    assert m["stress"][1, 1] == pytest.approx(syy, rel=0.02)
+    assert abs(m["stress"][0, 1] - sxy) < 0.02 * abs(syy)
+    p = sim.particles.numpy()
+    solid = np.pi * (p["radius"][:int((~shaped).sum())] ** 2).sum() + shaped.sum() * shape.area
+    assert m["porosity"] == pytest.approx(1.0 - solid / (W * top), rel=1e-9)
