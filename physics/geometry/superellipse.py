@@ -66,43 +66,9 @@ def rot(v, c, s):
 def support(shp, c, s, u):
     """(h(u), p(u)) of shape ``shp`` = (a, b, n) turned by (c, s) = (cos θ, sin θ),
     for a world unit direction u: the support function and the support point
-    (world frame, from the centre)."""
-    a = shp[0]
-    b = shp[1]
-    n = shp[2]
-    ub = rot(u, c, -s)          # body frame
-    h = 0.0
-    pb = ti.Vector([0.0, 0.0])
-    if n == 2.0:
-        ax = a * ub[0]
-        by = b * ub[1]
-        h = ti.sqrt(ax * ax + by * by)
-        pb = ti.Vector([a * ax, b * by]) / h
-    else:
-        q = n / (n - 1.0)
-        ax = ti.abs(a * ub[0])
-        by = ti.abs(b * ub[1])
-        m = ti.max(ax, by)
-        rx = ax / m
-        ry = by / m
-        sx = 0.0
-        sy = 0.0
-        if rx > 0.0:
-            sx = ti.pow(rx, q)
-        if ry > 0.0:
-            sy = ti.pow(ry, q)
-        ssum = sx + sy
-        h = m * ti.pow(ssum, 1.0 / q)
-        # ∇h = (a sgn(u_x) (|a u_x|/h)^(q−1), …); (|a u_x|/h)^(q−1) = (s_x / Σ)^(1/n)
-        e = 1.0 / n
-        px = 0.0
-        py = 0.0
-        if sx > 0.0:
-            px = a * ti.math.sign(ub[0]) * ti.pow(sx / ssum, e)
-        if sy > 0.0:
-            py = b * ti.math.sign(ub[1]) * ti.pow(sy / ssum, e)
-        pb = ti.Vector([px, py])
-    return h, rot(pb, c, s)
+    (world frame, from the centre); :func:`support_curv` without the curvature."""
+    h, p, _ = support_curv(shp, c, s, u)
+    return h, p
 
 
 @ti.func
@@ -134,35 +100,37 @@ def support_curv(shp, c, s, u):
         pb = ti.Vector([a * ax, b * by]) / h
         rho = (a * b) ** 2 / (h * h * h)
     else:
+        # with the larger of A = |a u'_x|, B = |b u'_y| as the scale, r = smaller/larger:
+        # h = larger·(1 + r^q)^(1/q), and the support point's components are a or b
+        # times (1/(1 + r^q))^(1/n) and (r^q/(1 + r^q))^(1/n) (by logarithms: two
+        # logarithms and four exponentials)
         q = n / (n - 1.0)
         A = ti.abs(a * ub[0])
         B = ti.abs(b * ub[1])
-        m = ti.max(A, B)
-        rx = A / m
-        ry = B / m
-        sx = 0.0
-        sy = 0.0
-        if rx > 0.0:
-            sx = ti.pow(rx, q)
-        if ry > 0.0:
-            sy = ti.pow(ry, q)
-        ssum = sx + sy
-        h = m * ti.pow(ssum, 1.0 / q)
-        e = 1.0 / n
-        px = 0.0
-        py = 0.0
-        if sx > 0.0:
-            px = a * ti.math.sign(ub[0]) * ti.pow(sx / ssum, e)
-        if sy > 0.0:
-            py = b * ti.math.sign(ub[1]) * ti.pow(sy / ssum, e)
-        pb = ti.Vector([px, py])
-        if sx > 0.0 and sy > 0.0:
-            # A^(q−2) = A^q/A², S^(1/q−2) = h/S², A^q = s_x m^q, S = Σ m^q:
-            # ρ = (q − 1) h s_x s_y / Σ² · w² / (A² B²)
-            Ax = rx * m
-            By = ry * m
-            w = By * By * a / b + Ax * Ax * b / a
-            rho = (q - 1.0) * h * sx * sy / (ssum * ssum) * w * w / (Ax * Ax * By * By)
+        big = ti.max(A, B)
+        r = ti.min(A, B) / big
+        lr = 0.0
+        sr = 0.0
+        if r > 0.0:
+            lr = q * ti.log(r)
+            sr = ti.exp(lr)
+        ssum = 1.0 + sr
+        ls = ti.log(ssum)
+        h = big * ti.exp(ls / q)
+        fb = ti.exp(-ls / n)
+        fs = 0.0
+        if r > 0.0:
+            fs = ti.exp((lr - ls) / n)
+        fx = fb
+        fy = fs
+        if A < B:
+            fx = fs
+            fy = fb
+        pb = ti.Vector([a * ti.math.sign(ub[0]) * fx, b * ti.math.sign(ub[1]) * fy])
+        if r > 0.0:
+            # ρ = (q − 1) h s_x s_y / Σ² · w² / (A² B²), the s scaled by the larger
+            w = B * B * a / b + A * A * b / a
+            rho = (q - 1.0) * h * sr / (ssum * ssum) * w * w / (A * A * B * B)
     return h, rot(pb, c, s), rho
 
 
