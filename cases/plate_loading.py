@@ -266,10 +266,7 @@ def plot_chains(results, png):
         p, c, t = r["particles"], r["contacts"], r["tags"]
         x, th = p["position"], np.radians(p["angle"])
         if bed[0] == "S":
-            body = shape.outline(32)
-            cs, sn = np.cos(th)[:, None], np.sin(th)[:, None]
-            polys = np.stack([x[:, None, 0] + cs * body[:, 0] - sn * body[:, 1],
-                              x[:, None, 1] + sn * body[:, 0] + cs * body[:, 1]], -1)
+            polys = shape.placed(x, th, 32)
         else:
             a = np.linspace(0, 2 * math.pi, 32, endpoint=False)
             polys = x[:, None, :] + R_CIRCLE * np.stack([np.cos(a), np.sin(a)], 1)[None]
@@ -277,7 +274,7 @@ def plot_chains(results, png):
         pairs = c["pairs"]
         inner = pairs[:, 1] >= 0
         a_ = x[pairs[inner, 0]]
-        d = b_ = x[pairs[inner, 1]] - a_
+        d = x[pairs[inner, 1]] - a_
         d[:, 0] -= WIDTH * np.round(d[:, 0] / WIDTH)
         b_ = a_ + d
         fn = c["normal"][inner]

@@ -108,6 +108,19 @@ class Superellipse:
         return np.stack([self.a * np.sign(c) * np.abs(c) ** e,
                          self.b * np.sign(s) * np.abs(s) ** e], axis=1)
 
+    def placed(self, centres, angles, m=64):
+        """Outlines (N, m, 2) of the shape at ``centres`` (N, 2) turned by ``angles``
+        (N,, radians): :meth:`outline` in the world frame."""
+        return np.asarray(centres, float)[:, None, :] + np.einsum(
+            "nij,mj->nmi", rotation(np.asarray(angles, float)), self.outline(m))
+
+    def support_world(self, u, angles):
+        """Support points (N, 2), from the centres, for world unit directions ``u``
+        (N, 2) of the shape turned by ``angles`` (N,, radians)."""
+        R = rotation(np.asarray(angles, float))
+        _, pb = self.support(np.einsum("nji,nj->ni", R, np.asarray(u, float)))
+        return np.einsum("nij,nj->ni", R, pb)
+
     def inside(self, x):
         """Miyata's Eq. 34 at body-frame points ``x`` (…, 2): < 0 inside, > 0 outside."""
         x = np.asarray(x, dtype=float)

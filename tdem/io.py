@@ -184,17 +184,12 @@ def write_shapes_vtu(sim, path, particles=None):
     rows = np.concatenate(sim._host["shape"]) if sim._n else np.zeros((0, 4))
     ids = np.flatnonzero(rows[:, 2] > 0)
     m = SHAPE_OUTLINE
-    pts = np.zeros((len(ids) * m, 2))
+    pts = np.zeros((len(ids), m, 2))
     th = np.radians(np.asarray(p["angle"])[ids])
     for key in np.unique(rows[ids, :3], axis=0):
         sel = np.flatnonzero(np.all(rows[ids, :3] == key, axis=1))
-        body = Superellipse(*key).outline(m)                   # (m, 2)
-        c, s_ = np.cos(th[sel])[:, None], np.sin(th[sel])[:, None]
-        x = p["position"][ids[sel]]
-        world = np.stack([x[:, None, 0] + c * body[None, :, 0] - s_ * body[None, :, 1],
-                          x[:, None, 1] + s_ * body[None, :, 0] + c * body[None, :, 1]], -1)
-        for k, q in enumerate(sel):
-            pts[q * m:(q + 1) * m] = world[k]
+        pts[sel] = Superellipse(*key).placed(p["position"][ids[sel]], th[sel], m)
+    pts = pts.reshape(-1, 2)
     cells = np.arange(len(ids) * m, dtype=np.int64).reshape(len(ids), m)
     st = np.zeros((len(ids), 3, 3))
     st[:, :2, :2] = np.asarray(p["stress"])[ids]

@@ -132,10 +132,7 @@ class Results:
             th = self._a["angle"].to_numpy()[ids]
             for key in np.unique(rows[rows[:, 2] > 0, :3], axis=0):
                 sel = np.flatnonzero(np.all(rows[:, :3] == key, axis=1))
-                c, s_ = np.cos(th[sel]), np.sin(th[sel])
-                nb = np.stack([c * n[sel, 0] + s_ * n[sel, 1], -s_ * n[sel, 0] + c * n[sel, 1]], 1)
-                _, pb = Superellipse(*key).support(nb)
-                pw = np.stack([c * pb[:, 0] - s_ * pb[:, 1], s_ * pb[:, 0] + c * pb[:, 1]], 1)
+                pw = Superellipse(*key).support_world(n[sel], th[sel])
                 arm[sel] = pw - 0.5 * u[sel, None] * n[sel]
         return arm
 
