@@ -14,7 +14,6 @@ figure, and their ratio (the issue's aim: at least one fifth).
 """
 import argparse
 import json
-import math
 import os
 import sys
 import time

@@ -13,7 +13,6 @@
   its two forces a period apart.)
 - Bad periods are refused, naming the argument.
 """
-import math
 
 import numpy as np
 import pytest
