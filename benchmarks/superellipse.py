@@ -69,10 +69,16 @@ def main(argv=None):
     p.add_argument("--arch", default=None)
     p.add_argument("--steps", type=int, default=2000)
     p.add_argument("--warmup", type=int, default=2000)
+    p.add_argument("--cols", type=int, default=100, help="columns of the bed")
+    p.add_argument("--rows", type=int, default=200, help="rows of the bed")
+    p.add_argument("--no-disc", action="store_true", help="skip the disc pack")
     args = p.parse_args(argv)
-    se = measure(args.steps, args.warmup, args.arch, args.threads)
-    n, disc, _ = pack2d.measure(200, 200, args.steps, args.warmup, args.arch, args.threads)
+    se = measure(args.steps, args.warmup, args.arch, args.threads, args.cols, args.rows)
     print(f"PEER tdem-superellipse {args.threads} particle_steps_per_s {se['rate']:.4g}")
+    if args.no_disc:
+        print(json.dumps({"superellipse": se}, indent=1))
+        return
+    n, disc, _ = pack2d.measure(200, 200, args.steps, args.warmup, args.arch, args.threads)
     print(f"PEER tdem {args.threads} particle_steps_per_s {disc:.4g}")
     print(json.dumps({"superellipse": se, "disc": {"particles": n, "rate": disc},
                       "ratio": se["rate"] / disc}, indent=1))

@@ -43,7 +43,7 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             f = nforce[v] + m * g
             v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
             # the reaction balances the physical forces only (damping is not one)
-            vfree, _ = damped_leapfrog(v0, f, m, alpha, 0.0, dt)
+            vfree, fd_free = damped_leapfrog(v0, f, m, alpha, 0.0, dt)
             fx = nfix[v]
             if fx & 1:
                 v1[0] = nvfix[v][0]

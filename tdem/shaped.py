@@ -67,8 +67,8 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
     apart = dist >= rbi + rbj
     if not apart and dist > 0.0 and h[ST] <= 0.0:
         dh = d / dist
-        hi, _ = se.support(shi, ti.cos(thi), ti.sin(thi), dh)
-        hj, _ = se.support(shj, ti.cos(thj), ti.sin(thj), -dh)
+        hi, spi = se.support(shi, ti.cos(thi), ti.sin(thi), dh)
+        hj, spj = se.support(shj, ti.cos(thj), ti.sin(thj), -dh)
         apart = hi + hj < dist
     if apart:
         if h[ST] != 0.0:

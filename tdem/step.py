@@ -564,6 +564,6 @@ def _arm(shaped, si, ci, sni, ri, n, u):
     """From a particle's centre to its contact of normal n (outward) and overlap u."""
     arm = (ri - 0.5 * u) * n
     if shaped:
-        _, p = se.support(ti.Vector([si[0], si[1], si[2]]), ci, sni, n)
+        h, p = se.support(ti.Vector([si[0], si[1], si[2]]), ci, sni, n)
         arm = p - 0.5 * u * n
     return arm

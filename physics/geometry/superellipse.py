@@ -67,7 +67,7 @@ def support(shp, c, s, u):
     """(h(u), p(u)) of shape ``shp`` = (a, b, n) turned by (c, s) = (cos θ, sin θ),
     for a world unit direction u: the support function and the support point
     (world frame, from the centre); :func:`support_curv` without the curvature."""
-    h, p, _ = support_curv(shp, c, s, u)
+    h, p, rho = support_curv(shp, c, s, u)
     return h, p
 
 
@@ -75,7 +75,7 @@ def support(shp, c, s, u):
 def curvature_radius(shp, c, s, u, cap):
     """Radius of curvature of the boundary at its point of outward normal u, capped
     at ``cap`` (module docstring)."""
-    _, _, rho = support_curv(shp, c, s, u)
+    h_unused, p_unused, rho = support_curv(shp, c, s, u)
     return ti.math.clamp(rho, 1e-6 * cap, cap)
 
 
@@ -153,10 +153,10 @@ def _eval(si, ci, sni, sj, cj, snj, d, phi, point: ti.template()):
 @ti.func
 def _value(si, ci, sni, sj, cj, snj, d, phi, point: ti.template()):
     u = ti.Vector([ti.cos(phi), ti.sin(phi)])
-    hi, _ = support(si, ci, sni, u)
+    hi, pi = support(si, ci, sni, u)
     hj = 0.0
     if ti.static(not point):
-        hj, _ = support(sj, cj, snj, -u)
+        hj, pj = support(sj, cj, snj, -u)
     return hi + hj - u.dot(d)
 
 
@@ -237,7 +237,7 @@ def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
 def point_depth(s, th, xp, phi0):
     """Depth of the point x_p (relative to the centre) inside shape ``s`` turned by
     ``th``: the pair function with h_j = 0. Returns (δ, n, p, converged)."""
-    f, u, p, _, _, ok, _, _ = pair_depth(s, th, s, 0.0, xp, phi0, False, True)
+    f, u, p, pj, phi, ok, ri, rj = pair_depth(s, th, s, 0.0, xp, phi0, False, True)
     return f, u, p, ok
 
 

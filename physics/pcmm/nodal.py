@@ -69,7 +69,7 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
                 r = efor[j]
                 f += _corner_force(code & 3, o, j, r, pos, efor)
                 ssum += ti.Vector([r[0], r[1], r[2], r[3]])
-                dxx, dyy, _ = _unpack2(r[5])
+                dxx, dyy, dpad = _unpack2(r[5])
                 dxy, ep, failed = _unpack2(r[6])
                 dsum += ti.Vector([dxx, dyy, dxy])
                 psum += ti.abs(ep)

@@ -132,7 +132,7 @@ def find_neighbours(pos: ti.types.ndarray(), rad: ti.types.ndarray(), tol: ti.f6
         nbr_cnt[i] = m
         for k in range(m, cap):
             nbr[i, k] = -1
-        m, _ = _ring(i, xi, m, pos, nbr, ring, ring_ang)
+        m, ring_ok = _ring(i, xi, m, pos, nbr, ring, ring_ang)
         ring_cnt[i] = m
         for k in range(m, cap):
             ring[i, k] = -1
@@ -147,7 +147,7 @@ def create_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(), tol: ti.f6
     rules: elem[A, s, 0:2] = (i, i+1), earea[A, s] = area S_e, s < ecnt[A]."""
     n = pos.shape[0]
     for a in range(n):
-        cnt, _ = _create(a, ring_cnt[a], pos[a], rad[a], tol, pos, rad, ring, elem, earea)
+        cnt, created = _create(a, ring_cnt[a], pos[a], rad[a], tol, pos, rad, ring, elem, earea)
         ecnt[a] = cnt
         for s in range(cnt, MAX_ELEMENTS):
             elem[a, s, 0] = -1
