@@ -39,7 +39,7 @@ from .errors import InputError
 from .step import W_LAW, WALL_WIDTH
 
 FORMAT = "tdem-checkpoint"
-VERSION = 2     # 2: particle shapes and angles; two more history columns
+VERSION = 3     # 2: particle shapes and angles; two more history columns; 3: work account
 _FIX_NAMES = ("vx", "vy", "omega")
 _HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle")
 
@@ -74,6 +74,7 @@ def _config(sim):
         "slots": [{"material": m.to_dict(), "tolerance": t} for m, t in sim._slots],
         "continuum_capacity": int(sim._cont.capacity) if sim._cont is not None else 0,
         "periodic": [None if p is None else [float(p[0]), float(p[1])] for p in sim._periodic],
+        "account0": sim._account0,
         "couples": [{"ids": None if ids is None else [int(i) for i in ids],
                      "a": None if a is None else int(a.index), "block": int(b.index),
                      "law": law.to_dict()} for ids, a, b, law in sim._couples],
@@ -287,10 +288,24 @@ def _read(path):
                                                for nm in _FIX_NAMES]))
     if version < 2:
         _upgrade_v1(state, host)
+    if version < 3:
+        _upgrade_v2(state)
     raw = dict(cfg=cfg, state=state, host=host, blocks=blocks, cstate=cstate, nonref=nonref,
-               fixes=fixes)
+               fixes=fixes, version=version)
     _check(r, raw)
     return raw
+
+
+def _upgrade_v2(state):
+    """A checkpoint written before the work account: the account starts at the load,
+    from the kinetic energy then."""
+    if "pos" in state and "prop" in state and "vel" in state:
+        n = len(state["pos"])
+        work = np.zeros((n, 6))
+        v, prop = state["vel"], state["prop"]
+        w = state.get("omega", np.zeros(n))
+        work[:, 5] = 0.5 * (prop[:, 1] * np.einsum("ij,ij->i", v, v) + prop[:, 2] * w * w)
+        state.setdefault("ework", work)
 
 
 def _upgrade_v1(state, host):
@@ -557,6 +572,10 @@ def load(path, arch=None):
         for kind, (ids, coef) in nonref.items():
             sim._cont.set_non_reflecting(kind, ids, coef)
     sim._last_fit = cfg["last_fit"]
+    sim._account0 = cfg.get("account0")
+    if raw["version"] < 3 and sim._cont is not None and sim._cont.nv:
+        # no work account before version 3: it starts at the load
+        sim._cont.restart_work()
     return sim
 
 

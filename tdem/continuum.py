@@ -24,7 +24,7 @@ import taichi as ti
 from coupling import point_edge as pe
 from physics import blocks as blk
 from physics import pcmm
-from physics.materials import JWL, MAT_WIDTH, Fluid
+from physics.materials import JWL, JWL_TYPE, MAT_G, MAT_K, MAT_TYPE, MAT_WIDTH, Fluid
 
 from . import backend
 from .errors import CapacityError, InputError
@@ -44,7 +44,7 @@ _SNAP_PARTICLES = ("psig", "peps", "pstate", "pjwl", "xforce", "ccnt", "ecnt", "
                    "esig")
 _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig", "tstate",
                            "nflags", "psedge", "psforce", "psbroken", "vsedge", "vsforce",
-                           "vsbroken", "rstate")
+                           "vsbroken", "rstate", "nwork", "rwork")
 # what a checkpoint saves: the dynamic state and the nodes' initial positions (the rest
 # is set up again from the host description), and what the element system derives at
 # each step that ``elements()`` reads (element areas and N_e: a loaded model reports
@@ -274,6 +274,9 @@ class Continuum:
                         ("nvfix", 2), ("nmass", 0), ("nsize", 0)):
             a[k] = _arr(spec, (nv,))
         a["nfix"] = ti.ndarray(ti.i32, (nv,))
+        # the work done on each node since the start (tdem.nodes.integrate_nodes) and
+        # its kinetic energy at the start
+        a["nwork"] = _arr(5, (nv,))
         a["tri"] = schema.ndarray(3, ti.i32, (nt,))
         a["tmat"] = ti.ndarray(ti.i32, (nt,))
         a["tsig"] = _arr(4, (nt,))
@@ -289,8 +292,12 @@ class Continuum:
         t = np.concatenate(tris)
         a["npos"].from_numpy(x)
         a["npos0"].from_numpy(x)
-        a["nvel"].from_numpy(np.concatenate([b.velocity for b in self.blocks]))
+        nvel = np.concatenate([b.velocity for b in self.blocks])
+        a["nvel"].from_numpy(nvel)
         a["nmass"].from_numpy(np.concatenate(mass))
+        work = np.zeros((off, 5))
+        work[:, 4] = 0.5 * np.concatenate(mass) * np.einsum("ij,ij->i", nvel, nvel)
+        a["nwork"].from_numpy(work)
         a["nsize"].from_numpy(np.concatenate(size))
         a["tri"].from_numpy(t.astype(np.int32))
         a["tmat"].from_numpy(np.concatenate(tmat))
@@ -409,10 +416,20 @@ class Continuum:
         self.nrigid = len(rows)
         a["rbody"] = ti.ndarray(ti.f64, (max(len(rows), 1), 4))
         a["rstate"] = ti.ndarray(ti.f64, (max(len(rows), 1), 6))
+        # the work of the nodal forces, gravity and damping since the start, and the
+        # kinetic energy at the start (tdem.nodes.integrate_rigid)
+        a["rwork"] = ti.ndarray(ti.f64, (max(len(rows), 1), 4))
         a["rref"] = _arr(2, (max(self.nv, 1),))
         if rows:
             a["rbody"].from_numpy(np.array(rows, float))
             a["rstate"].from_numpy(np.array(state, float))
+            work = np.zeros((len(rows), 4))
+            nwork = a["nwork"].to_numpy()
+            for q, (r, st) in enumerate(zip(rows, state)):
+                work[q, 3] = 0.5 * r[2] * (st[2] ** 2 + st[3] ** 2) + 0.5 * r[3] * st[5] ** 2
+                nwork[int(r[0]):int(r[0]) + int(r[1]), 4] = 0.0   # counted with the body
+            a["rwork"].from_numpy(work)
+            a["nwork"].from_numpy(nwork)
             ref = np.zeros((self.nv, 2))
             for r, s in zip(rows, state):
                 o, k = int(r[0]), int(r[1])
@@ -577,10 +594,10 @@ class Continuum:
             a = self.a
             if self.nrigid:
                 integrate_rigid(a["npos"], a["nvel"], a["nforce"], a["nmass"], a["rbody"],
-                                a["rstate"], a["rref"], sim._a["simp"])
+                                a["rstate"], a["rref"], a["rwork"], sim._a["simp"])
             integrate_nodes(a["npos"], a["nvel"], a["nmass"], a["nforce"], a["nfix"],
-                            a["nvfix"], a["nsize"], a["nreact"], sim._a["simp"], a["nflags"],
-                            sim._serial())
+                            a["nvfix"], a["nsize"], a["nreact"], a["nwork"], sim._a["simp"],
+                            a["nflags"], sim._serial())
 
     def status(self):
         """(candidate slots needed, first unstable node or −1)."""
@@ -695,6 +712,75 @@ class Continuum:
                 "weight": 1.0 / np.maximum(ncov, 1),
                 "stress": _tensor(sig), "stress_zz": sig[:, 3].copy()}
 
+    def strain_energy(self):
+        """Elastic strain energy (J/m) stored in the PCMM elements and the blocks'
+        triangles: Σ w A (p²/2K + s:s/4G) over the elements, with the stress's mean p
+        and deviator s (σ_zz included, plane strain), the element's area A and, for
+        PCMM elements, their weight w = 1/N_e (as in their nodal forces). This is
+        ½ σ:ε for the elastic part of the strain; JWL products keep theirs as internal
+        energy (``energy()["explosive"]``), a Fluid (G = 0) only its pressure part.
+        Rigid blocks store none."""
+        total = 0.0
+        rows = np.array([m.row() for m, _ in self.slots]) if self.slots else np.zeros((0, MAT_WIDTH))
+        if self.has_pcmm:
+            e = self.elements()
+            if len(e["owner"]):
+                mat = self.a["pmat"].to_numpy()[e["owner"]]
+                total += _stored(e["stress"], e["stress_zz"], rows[mat], e["area"] * e["weight"])
+        if self.nt:
+            x = self.a["npos"].to_numpy()
+            for b in self.blocks:
+                if b.rigid:
+                    continue
+                el = self.block_elements(b)
+                t = b.triangles + b._offset
+                d1, d2 = x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]]
+                area = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+                row = np.broadcast_to(np.asarray(b.material.row(), float), (len(t), MAT_WIDTH))
+                total += _stored(el["stress"], el["stress_zz"], row, area)
+        return total
+
+    def restart_work(self):
+        """The work account of the nodes and rigid blocks starts now (zero work, the
+        kinetic energy now as the start's)."""
+        a = self.a
+        v = a["nvel"].to_numpy()
+        nw = np.zeros((len(v), 5))
+        free = (a["nfix"].to_numpy() & RIGID_NODE) == 0
+        nw[:, 4] = np.where(free, 0.5 * a["nmass"].to_numpy() * np.einsum("ij,ij->i", v, v), 0.0)
+        a["nwork"].from_numpy(nw)
+        if self.nrigid:
+            st = a["rstate"].to_numpy()
+            body = a["rbody"].to_numpy()
+            rw = np.zeros(a["rwork"].shape)
+            rw[:, 3] = 0.5 * body[:, 2] * (st[:, 2] ** 2 + st[:, 3] ** 2) \
+                + 0.5 * body[:, 3] * st[:, 5] ** 2
+            a["rwork"].from_numpy(rw)
+
+    def work_sums(self):
+        """(work of the nodal forces, gravity, damping, constraints on the block nodes
+        and rigid blocks since the start (J/m), their kinetic energy ½ m v² now at
+        the half step, and at the start)."""
+        w = np.zeros(4)
+        ke = ke0 = 0.0
+        if self.nv:
+            a = self.a
+            nw = a["nwork"].to_numpy()
+            free = (a["nfix"].to_numpy() & RIGID_NODE) == 0
+            v = a["nvel"].to_numpy()[free]
+            w += nw[:, :4].sum(axis=0)
+            ke += 0.5 * float(a["nmass"].to_numpy()[free] @ np.einsum("ij,ij->i", v, v))
+            ke0 += float(nw[:, 4].sum())
+            if self.nrigid:
+                rw = a["rwork"].to_numpy()[:self.nrigid]
+                st = a["rstate"].to_numpy()[:self.nrigid]
+                body = a["rbody"].to_numpy()[:self.nrigid]
+                w[:3] += rw[:, :3].sum(axis=0)
+                ke += float(np.sum(0.5 * body[:, 2] * (st[:, 2] ** 2 + st[:, 3] ** 2)
+                                   + 0.5 * body[:, 3] * st[:, 5] ** 2))
+                ke0 += float(rw[:, 3].sum())
+        return w, ke, ke0
+
     def particle_fields(self):
         """Continuum state per particle: stress (N, 4), strain (N, 3), plastic shear
         strain, failed, element count."""
@@ -758,6 +844,19 @@ class Continuum:
 def _boundary_edges(triangles):
     from .mesh import boundary_edges
     return boundary_edges(triangles)
+
+
+def _stored(sig, szz, rows, weight):
+    """Σ weight · (p²/2K + s:s/4G) of stresses (E, 2, 2) and σ_zz (E,) with material rows
+    (E, MAT_WIDTH); JWL rows count nothing, G = 0 rows their pressure part only."""
+    k, g, kind = rows[:, MAT_K], rows[:, MAT_G], rows[:, MAT_TYPE]
+    p = (sig[:, 0, 0] + sig[:, 1, 1] + szz) / 3.0
+    ss = ((sig[:, 0, 0] - p) ** 2 + (sig[:, 1, 1] - p) ** 2 + (szz - p) ** 2
+          + 2.0 * sig[:, 0, 1] ** 2)
+    w = np.where(k > 0, p * p / (2.0 * np.where(k > 0, k, 1.0)), 0.0) \
+        + np.where(g > 0, ss / (4.0 * np.where(g > 0, g, 1.0)), 0.0)
+    w = np.where(kind == JWL_TYPE, 0.0, w)
+    return float(np.sum(weight * w))
 
 
 def _tensor(s4):

@@ -21,12 +21,13 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                     nmass: ti.types.ndarray(), nforce: ti.types.ndarray(),
                     nfix: ti.types.ndarray(), nvfix: ti.types.ndarray(),
                     nsize: ti.types.ndarray(), nreact: ti.types.ndarray(),
-                    simp: ti.types.ndarray(), nflags: ti.types.ndarray(),
-                    serial: ti.template()):
+                    nwork: ti.types.ndarray(), simp: ti.types.ndarray(),
+                    nflags: ti.types.ndarray(), serial: ti.template()):
     """Block nodes, as the particles in :func:`tdem.step.step`: gravity, local and
     global damping, prescribed velocity components (``nreact`` = the force the
-    constraint applies), leapfrog. nflags[0] = smallest index of a node with a
-    non-finite state or moving more than half its size in one step."""
+    constraint applies), leapfrog, the work of each force (``nwork``: the nodal
+    forces, gravity, damping, the constraint). nflags[0] = smallest index of a node
+    with a non-finite state or moving more than half its size in one step."""
     dt = simp[P_DT]
     g = ti.Vector([simp[P_GX], simp[P_GY]])
     alpha = simp[P_ALPHA]
@@ -44,12 +45,17 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
             # the reaction balances the physical forces only (damping is not one)
             vfree, fd_free = damped_leapfrog(v0, f, m, alpha, 0.0, dt)
+            vdamp = v1
             fx = nfix[v]
             if fx & 1:
                 v1[0] = nvfix[v][0]
             if fx & 2:
                 v1[1] = nvfix[v][1]
             nreact[v] = m * (v1 - vfree) / dt
+            vm = 0.5 * (v0 + v1)
+            nwork[v] += ti.Vector([nforce[v].dot(vm) * dt, m * g.dot(vm) * dt,
+                                   (fd - alpha * m * 0.5 * (v0 + vdamp)).dot(vm) * dt,
+                                   m * (v1 - vdamp).dot(vm), 0.0])
             x1 = npos[v] + v1 * dt
             nvel[v] = v1
             npos[v] = x1
@@ -83,11 +89,13 @@ def viscous_boundary(vel: ti.types.ndarray(), force: ti.types.ndarray(),
 def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                     nforce: ti.types.ndarray(), nmass: ti.types.ndarray(),
                     rbody: ti.types.ndarray(), rstate: ti.types.ndarray(),
-                    rref: ti.types.ndarray(), simp: ti.types.ndarray()):
+                    rref: ti.types.ndarray(), rwork: ti.types.ndarray(),
+                    simp: ti.types.ndarray()):
     """Rigid blocks: force and moment of their nodes' forces about the centre, plus
     gravity; local and global damping as for particles; leapfrog for the centre and
     the angle; the nodes are then placed rigidly, x = c + R(θ)·r₀, and given the
-    rigid-body velocity v + ω × (x − c)."""
+    rigid-body velocity v + ω × (x − c). ``rwork``: the work of the nodal forces,
+    gravity and damping, as ``nwork`` of :func:`integrate_nodes`."""
     dt = simp[P_DT]
     g = ti.Vector([simp[P_GX], simp[P_GY]])
     alpha = simp[P_ALPHA]
@@ -102,15 +110,21 @@ def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             c = ti.Vector([rstate[r, 0], rstate[r, 1]])
             v0 = ti.Vector([rstate[r, 2], rstate[r, 3]])
             w0 = rstate[r, 5]
-            f = m * g
+            fn = ti.Vector([0.0, 0.0])
             mom = 0.0
             for q in range(o, o + k):
                 fq = nforce[q]
                 d = npos[q] - c
-                f += fq
+                fn += fq
                 mom += d[0] * fq[1] - d[1] * fq[0]
-            v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
+            v1, fd = damped_leapfrog(v0, fn + m * g, m, alpha, alpha_l, dt)
             w1, md = damped_leapfrog(w0, mom, inertia, alpha, alpha_l, dt)
+            vm = 0.5 * (v0 + v1)
+            wm = 0.5 * (w0 + w1)
+            w_damp = ((fd - alpha * m * vm).dot(vm) + (md - alpha * inertia * wm) * wm) * dt
+            for c4 in ti.static(range(4)):
+                rwork[r, c4] += ti.Vector([(fn.dot(vm) + mom * wm) * dt, m * g.dot(vm) * dt,
+                                           w_damp, 0.0])[c4]
             c1 = c + v1 * dt
             th = rstate[r, 4] + w1 * dt
             cs = ti.cos(th)

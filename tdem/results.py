@@ -179,25 +179,103 @@ class Results:
 
     def energy(self):
         """Energy account (J per metre of thickness) at the last completed step:
-        kinetic, gravitational (relative to the origin), elastic (springs),
+        kinetic, gravitational (relative to the origin), elastic (contact springs),
+        strain (PCMM elements and blocks, :meth:`tdem.continuum.Continuum.strain_energy`),
         dissipated (damping, friction, rolling), boundary_work (done by walls and
-        prescribed velocities) and total = kinetic + gravitational + elastic +
+        prescribed velocities) and total = kinetic + gravitational + elastic + strain +
         dissipated − boundary_work, which is conserved for DEM models; explosive: the
-        internal energy Σ E·V0 of JWL particles (not in total: the strain energy of
-        the continuum elements is not counted)."""
+        internal energy Σ E·V0 of JWL particles (not in total).
+
+        integration_error: what the contact and element forces did to the bodies
+        beyond the energy their springs and elements stored and their friction and
+        dashpots dissipated, since the end of the first step, −(W_contacts +
+        W_continuum) − Δ(elastic + strain) − Δ(contact dissipation) + Δ(work of the
+        walls), with the works of :meth:`work`. It is the error of the time
+        integration (second order: it falls as Δt² on smooth motion), plus what is
+        dissipated without being booked (viscous element stresses, point–edge
+        friction). The booked work runs half a step ahead of the stored energy; that
+        offset, ½ Δt F·v of the last step, is taken out (for a linear spring the
+        line is then zero: the leapfrog keeps its discrete energy exactly)."""
         if not self._built:
             self._build()
+        e = self._account_now()
+        out = {k: e[k] for k in ("kinetic", "gravitational", "elastic", "strain", "dissipated",
+                                 "boundary_work")}
+        out["total"] = out["kinetic"] + out["gravitational"] + out["elastic"] + out["strain"] \
+            + out["dissipated"] - out["boundary_work"]
+        out["explosive"] = self._explosive_energy()
+        e0 = self._account0 if self._account0 is not None else e
+        out["integration_error"] = _integration_error(e, e0)
+        return out
+
+    def work(self):
+        """Work account (J per metre of thickness) since the bodies were added: the
+        work each force did, booked at every step as F·(v_{n−1/2} + v_{n+1/2})/2·Δt
+        (moments likewise with the spins). For the leapfrog this sums exactly to the
+        change of the kinetic energy at the half steps, ½ m v_{n+1/2}², so
+        ``residual`` (kinetic_change − total) is round-off.
+
+        kinetic_change; contacts (particle pairs and walls); continuum (PCMM elements,
+        point–edge contacts and non-reflecting boundaries on particles, the nodal
+        forces of blocks); gravity; damping (local and global, ≤ 0); constraints
+        (prescribed velocities); total (their sum); residual."""
+        if not self._built:
+            self._build()
+        e = self._account_now()
+        w = {k: e["W_" + k] for k in ("contacts", "continuum", "gravity", "damping",
+                                      "constraints")}
+        out = {"kinetic_change": e["ke_half"] - e["ke_start"], **w}
+        out["total"] = float(sum(w.values()))
+        out["residual"] = out["kinetic_change"] - out["total"]
+        return out
+
+    def _account_now(self):
+        """Every sum the energy and work accounts are made of, now (host floats)."""
+        e = dict.fromkeys(("kinetic", "gravitational", "elastic", "strain", "dissipated",
+                           "boundary_work", "W_contacts", "W_continuum", "W_gravity",
+                           "W_damping", "W_constraints", "Wp_damping", "Wp_constraints",
+                           "ke_half", "ke_start", "P_half"), 0.0)
+        dt = self._dt_run if getattr(self, "_dt_run", None) else 0.0
         a = self._a
-        eacc = a["eacc"].to_numpy()
-        estate = a["estate"].to_numpy()
-        el = stepk.elastic_energy_sum(*schema.bind(stepk.elastic_energy_sum, a,
-                                                   laws=self._law_set))
-        e = {"kinetic": float(estate[:, 0].sum()), "gravitational": float(estate[:, 1].sum()),
-             "elastic": float(el), "dissipated": float(eacc[:, 0].sum()),
-             "boundary_work": float(eacc[:, 1].sum())}
-        e["total"] = e["kinetic"] + e["gravitational"] + e["elastic"] + e["dissipated"] \
-            - e["boundary_work"]
-        e["explosive"] = self._explosive_energy()
+        if self._n:
+            eacc = a["eacc"].to_numpy()
+            estate = a["estate"].to_numpy()
+            work = a["ework"].to_numpy()
+            prop = a["prop"].to_numpy()
+            v = a["vel"].to_numpy()
+            w = a["omega"].to_numpy()
+            e["kinetic"] = float(estate[:, 0].sum())
+            e["gravitational"] = float(estate[:, 1].sum())
+            e["elastic"] = float(stepk.elastic_energy_sum(*schema.bind(
+                stepk.elastic_energy_sum, a, laws=self._law_set)))
+            e["dissipated"] = float(eacc[:, 0].sum())
+            e["boundary_work"] = float(eacc[:, 1].sum())
+            ws = work.sum(axis=0)
+            for c, k in enumerate(("contacts", "continuum", "gravity", "damping",
+                                   "constraints")):
+                e["W_" + k] = float(ws[c])
+            e["Wp_damping"], e["Wp_constraints"] = float(ws[3]), float(ws[4])
+            e["ke_start"] = float(ws[5])
+            e["ke_half"] = float(0.5 * np.sum(prop[:, 1] * np.einsum("ij,ij->i", v, v)
+                                              + prop[:, 2] * w * w))
+            # ½ Δt F_n·v_{n+1/2} of the contact and element forces of the last step:
+            # the half step by which the booked work runs ahead of the stored energy
+            f = a["force"].to_numpy()
+            e["P_half"] = 0.5 * dt * float(np.sum(np.einsum("ij,ij->i", f, v)
+                                                  + a["torque"].to_numpy() * w))
+        if self._cont is not None:
+            e["strain"] = self._cont.strain_energy()
+            nw, ke, ke0 = self._cont.work_sums()
+            e["W_continuum"] += float(nw[0])
+            e["W_gravity"] += float(nw[1])
+            e["W_damping"] += float(nw[2])
+            e["W_constraints"] += float(nw[3])
+            e["ke_half"] += ke
+            e["ke_start"] += ke0
+            if self._cont.nv:
+                ca = self._cont.a
+                e["P_half"] += 0.5 * dt * float(np.sum(ca["nforce"].to_numpy()
+                                                       * ca["nvel"].to_numpy()))
         return e
 
     def _explosive_energy(self):
@@ -207,3 +285,15 @@ class Results:
             return 0.0
         st = c.jwl_state()[c.jwl_ids]
         return float(np.sum(st[:, 1] * st[:, 4]))
+
+
+def _integration_error(e, e0):
+    """−ΔW_contacts − ΔW_continuum − Δ(elastic + strain) − Δ(contact dissipation) + Δ(work
+    of the walls), between two accounts of :meth:`Results._account_now`; the particles'
+    damping and constraint work are taken out of ``dissipated`` and ``boundary_work``."""
+    def d(k):
+        return e[k] - e0[k]
+    contact_dissipation = d("dissipated") + d("Wp_damping")
+    wall_work = d("boundary_work") - d("Wp_constraints")
+    return -(d("W_contacts") + d("W_continuum")) - d("elastic") - d("strain") \
+        - contact_dissipation + wall_work + d("P_half")

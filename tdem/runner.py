@@ -99,7 +99,10 @@ class Runner:
     def _new_rows(self, pos, vel, r, m, inertia, law, shape, angle, cap, capw):
         """State rows of new particles (every saved per-particle and per-slot array)."""
         sizes = self._sizes(len(r), cap, capw, 1, 1, 1)
+        work = np.zeros((len(r), 6))
+        work[:, 5] = 0.5 * np.asarray(m) * np.einsum("ij,ij->i", vel, vel)   # the start's ½ m v²
         return schema.fresh_rows(len(r), sizes, {
+            "ework": work,
             "pos": pos, "vel": vel, "pos0": pos, "xref": pos, "shp": shape, "angle": angle,
             "prop": np.stack([r, m, inertia], axis=1),
             "plaw": np.broadcast_to(np.asarray(law, np.int32), (len(r),))})
@@ -483,6 +486,8 @@ class Runner:
         if self._n:
             schema.copy(self._snap, self._a, schema.dynamic(), self._serial())
         self._time, self._steps = self._snap_clock
+        if self._steps == 0:
+            self._account0 = None      # taken again after the replayed first step
         for m in self._monitors:
             m.truncate(self._steps)
         if self._output is not None:
@@ -611,15 +616,21 @@ class Runner:
             self._nonconv_reported = count
 
     def _segment(self, target, bar):
-        """Up to ``check_interval`` steps from a snapshot, then one look at the device."""
+        """Up to ``check_interval`` steps from a snapshot, then one look at the device.
+        The energy account's reference (``_account0``, :meth:`energy`) is taken after
+        the model's first step, when every contact and element of the start has been
+        evaluated (a replayed step gives the same)."""
         n = min(self.check_interval, target - self._steps)
         self._take_snapshot()
         sargs, rargs = self._engine_args()
         host_flag = self._host_reads_flag
         for s in range(n):
             # output-only quantities are stored on the steps something will read them
-            detail = s == n - 1 or self._steps + 1 >= self._next_event
+            first = self._account0 is None
+            detail = s == n - 1 or self._steps + 1 >= self._next_event or first
             self._one_step(sargs, rargs, host_flag, detail)
+            if first:
+                self._account0 = self._account_now()
             if self._steps >= self._next_event:
                 self._events()
         flags = self._status()

@@ -144,6 +144,7 @@ class Simulation(Runner, Results):
                                       "angle")}
         self._shaped_cache = None
         self._nonconv_reported = 0
+        self._account0 = None      # the energy account after the first step (Results.energy)
         self._slots = []           # (material, tolerance) of PCMM bodies and blocks
         self._blocks = []
         self._cont = None          # Continuum (PCMM elements, blocks) once built

@@ -224,7 +224,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          vfix: ti.types.ndarray(), force: ti.types.ndarray(), torque: ti.types.ndarray(),
          xref: ti.types.ndarray(), pos0: ti.types.ndarray(), facc: ti.types.ndarray(),
          eacc: ti.types.ndarray(),
-         estate: ti.types.ndarray(),
+         estate: ti.types.ndarray(), ework: ti.types.ndarray(),
          nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
          cn: ti.types.ndarray(), cf: ti.types.ndarray(), cs: ti.types.ndarray(),
          rev: ti.types.ndarray(), rcnt: ti.types.ndarray(),
@@ -362,8 +362,11 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     c = cf[j, k]
                     f -= ti.Vector([c[0], c[1]])
                     tq += c[2]
+        fx_cont = ti.Vector([0.0, 0.0])
         if ti.static(continuum):
-            f += xforce[i]
+            fx_cont = xforce[i]
+        fc = f
+        f += fx_cont
         m = prop[i][PROP_MASS]
         inertia = prop[i][PROP_INERTIA]
         v0 = vel[i]
@@ -383,16 +386,21 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 v1[1] = vf[1]
             if fx & 4:
                 w1 = vf[2]
-        # energy at t_n with the mid-point velocities: work of the damping, and of the
-        # constraint that imposes prescribed velocities (contact dissipation and the
-        # walls' work were booked in 1.)
+        # the work of each force over the step, F·(v_{n-1/2} + v_{n+1/2})/2 Δt: with
+        # the leapfrog's m(v_{n+1/2} − v_{n−1/2}) = ΣF Δt their sum is the change of
+        # ½ m v² at the half steps, exactly (round-off apart). The damping force is
+        # F_d − α m (v_{n−1/2} + v_free)/2 (tdem.integrate), the constraint's impulse
+        # m (v_{n+1/2} − v_free). Contact dissipation and the walls' work were booked in 1.
         vm = 0.5 * (v0 + v1)
         wm = 0.5 * (w0 + w1)
         x0 = pos[i]
+        w_damp = ((fd - alpha * m * 0.5 * (v0 + vfree)).dot(vm)
+                  + (md - alpha * inertia * 0.5 * (w0 + wfree)) * wm) * dt
+        w_fix = m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm
+        ework[i] += ti.Vector([(fc.dot(vm) + tq * wm) * dt, fx_cont.dot(vm) * dt,
+                               m * g.dot(vm) * dt, w_damp, w_fix, 0.0])
         if alpha != 0.0 or alpha_l != 0.0 or fx != 0:
-            eacc[i] += ti.Vector([
-                (alpha * (m * vm.dot(vm) + inertia * wm * wm) - fd.dot(vm) - md * wm) * dt,
-                m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm])
+            eacc[i] += ti.Vector([-w_damp, w_fix])
         if ti.static(detail):
             force[i] = f
             torque[i] = tq
