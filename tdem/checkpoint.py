@@ -41,7 +41,7 @@ from .step import W_LAW, WALL_WIDTH
 FORMAT = "tdem-checkpoint"
 VERSION = 3     # 2: particle shapes and angles; two more history columns; 3: work account
 _FIX_NAMES = ("vx", "vy", "omega")
-_HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle")
+_HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle", "omega")
 
 
 def _config(sim):
@@ -521,6 +521,8 @@ def load(path, arch=None):
     offsets = np.concatenate([[0], np.cumsum(host["sizes"])]).astype(np.int64)
     if "mat" not in host and "radius" in host:
         host["mat"] = np.full(len(host["radius"]), -1)
+    if "omega" not in host and "radius" in host:
+        host["omega"] = np.zeros(len(host["radius"]))     # written before initial spins
     for k in _HOST_KEYS:
         sim._host[k] = ([np.array(host[k][a:b]) for a, b in zip(offsets[:-1], offsets[1:])]
                         if k in host else [])

@@ -91,18 +91,22 @@ class Runner:
             inertia = np.where(np.isnan(pm), inertia, 0.5 * pm * r ** 2)
             m = np.where(np.isnan(pm), m, pm)
         n = len(r)
+        om = (np.concatenate(self._host["omega"]) if len(self._host["omega"]) == len(
+            self._host["pos"]) else np.zeros(n))
         s = self._new_rows(pos, vel, r, m, inertia, np.concatenate(self._host["law"]), shape,
-                           np.concatenate(self._host["angle"]), self._cap, self._capw)
+                           np.concatenate(self._host["angle"]), om, self._cap, self._capw)
         s["flags"] = np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32)
         return s
 
-    def _new_rows(self, pos, vel, r, m, inertia, law, shape, angle, cap, capw):
+    def _new_rows(self, pos, vel, r, m, inertia, law, shape, angle, omega, cap, capw):
         """State rows of new particles (every saved per-particle and per-slot array)."""
         sizes = self._sizes(len(r), cap, capw, 1, 1, 1)
         work = np.zeros((len(r), 6))
-        work[:, 5] = 0.5 * np.asarray(m) * np.einsum("ij,ij->i", vel, vel)   # the start's ½ m v²
+        # the kinetic energy at the start, ½ m v² + ½ I ω²
+        work[:, 5] = 0.5 * (np.asarray(m) * np.einsum("ij,ij->i", vel, vel)
+                            + np.asarray(inertia) * omega * omega)
         return schema.fresh_rows(len(r), sizes, {
-            "ework": work,
+            "ework": work, "omega": omega,
             "pos": pos, "vel": vel, "pos0": pos, "xref": pos, "shp": shape, "angle": angle,
             "prop": np.stack([r, m, inertia], axis=1),
             "plaw": np.broadcast_to(np.asarray(law, np.int32), (len(r),))})
@@ -143,10 +147,10 @@ class Runner:
         """(Re)allocate every array for the current sizes and fill it from ``state``."""
         self._set_law_set(state)
         if new_particles is not None:
-            pos, vel, r, rho, law, shape, ang = new_particles
+            pos, vel, r, rho, law, shape, ang, om = new_particles
             m, inertia = mass_properties(shape, rho, r)
             n = len(r)
-            add = self._new_rows(pos, vel, r, m, inertia, law, shape, ang,
+            add = self._new_rows(pos, vel, r, m, inertia, law, shape, ang, om,
                                  state["nbr"].shape[1], state["wid"].shape[1])
             for k, v in add.items():
                 state[k] = np.concatenate([state[k], v])

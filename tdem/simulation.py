@@ -141,7 +141,7 @@ class Simulation(Runner, Results):
         self._pair_override = {}   # (law a, law b) -> law id
         self._groups = []
         self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat", "shape",
-                                      "angle")}
+                                      "angle", "omega")}
         self._shaped_cache = None
         self._nonconv_reported = 0
         self._account0 = None      # the energy account after the first step (Results.energy)
@@ -226,11 +226,13 @@ class Simulation(Runner, Results):
         return self
 
     def add_particles(self, positions, radius=None, density=2500.0, contact=None,
-                      material=None, tolerance=0.0, velocity=None, shape=None, angle=None):
+                      material=None, tolerance=0.0, velocity=None, shape=None, angle=None,
+                      omega=None):
         """Add discs (``radius``) or shaped particles (``shape``, e.g.
         :class:`tdem.Superellipse`, turned by ``angle``: degrees, counter-clockwise, a
         number or one per particle; default 0); returns a :class:`ParticleGroup`
-        (``.ids`` their indices). A shape's bounding radius (the largest distance of its boundary from
+        (``.ids`` their indices). ``velocity``: (N, 2) or (2,), m/s; ``omega``: the
+        initial spin, rad/s counter-clockwise, a number or one per particle. A shape's bounding radius (the largest distance of its boundary from
         its centre) serves as the
         particle's radius (neighbour search, output); its mass and inertia are the
         shape's. Shaped particles take the linear or Hertz–Mindlin law (no rolling
@@ -314,6 +316,10 @@ class Simulation(Runner, Results):
         if contact is None:
             raise InputError("contact must be given: a law such as tdem.LinearContact(kn=...)")
         vel = np.zeros((n, 2)) if velocity is None else _as_xy("velocity", velocity, n)
+        om = _per_particle("omega", 0.0 if omega is None else omega, n)
+        if not np.isfinite(om).all():
+            k = int(np.argmax(~np.isfinite(om)))
+            raise InputError(f"omega must be finite: particle {k} has omega {float(om[k])!r}")
         state = self._download() if self._built else None
         old = state["pos"] if state is not None else (
             np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, 2)))
@@ -336,11 +342,12 @@ class Simulation(Runner, Results):
         self._host["mat"].append(np.full(n, slot))
         self._host["shape"].append(shp)
         self._host["angle"].append(ang)
+        self._host["omega"].append(om)
         self._n += n
         g = ParticleGroup(self, ids, contact, rho)
         self._groups.append(g)
         if state is not None:
-            self._rebuild_from(state, new_particles=(pos, vel, r, rho, law, shp, ang))
+            self._rebuild_from(state, new_particles=(pos, vel, r, rho, law, shp, ang, om))
         return g
 
     def _dem_radii(self, state):

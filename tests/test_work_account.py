@@ -176,3 +176,24 @@ def test_strain_energy_of_a_vibrating_block_matches_the_work_of_its_forces():
         assert e[:, 1].max() > 0.5 * 0.5 * 2500.0 * 0.1 * (0.1 ** 2 + 0.05 ** 2)
         assert np.abs(e[:, 0]).max() < 1e-3 * e[:, 1].max()
         assert abs(w["residual"]) < 1e-9 * _scale(w)
+
+
+def test_initial_spin_counts_in_the_kinetic_energy():
+    """A disc thrown spinning (omega=) onto a rough floor: its spin is read back, the
+    start's kinetic energy holds ½ I ω², and friction turns spin into rolling; the
+    account closes."""
+    sim = tdem.Simulation(gravity=(0.0, -G))
+    law = tdem.LinearContact(kn=1e5, friction=0.5)
+    g = sim.add_particles([[0.0, 0.1]], 0.1, density=1000.0, contact=law, omega=20.0)
+    sim.add_wall((-5.0, 0.0), (5.0, 0.0), contact=law)
+    assert sim.particles.numpy()["omega"][g.ids[0]] == 20.0
+    m = 1000.0 * math.pi * 0.01
+    ke0 = 0.5 * (0.5 * m * 0.01) * 400.0
+    sim.run(until=0.5)
+    p = sim.particles.numpy()
+    w = sim.work()
+    assert w["kinetic_change"] == pytest.approx(
+        0.5 * m * (p["velocity"][0] ** 2).sum() + 0.25 * m * 0.01 * p["omega"][0] ** 2 - ke0,
+        rel=1e-12)
+    assert p["velocity"][0, 0] < -0.1              # spin turned into motion (ω > 0: leftward)
+    assert abs(w["residual"]) < 1e-9 * _scale(w)
