@@ -111,6 +111,13 @@ def save(sim, path):
                 host.create_dataset(k, data=np.concatenate(chunks))
         walls = np.asarray(sim._walls_host, dtype=np.float64)
         host.create_dataset("walls", data=walls.reshape(len(sim._walls_host), WALL_WIDTH))
+        fn_loads = [k for k, (ids, *vals) in enumerate(sim._loads) if any(map(callable, vals))]
+        fn_loads += [f"block {b.index}" for b in sim._blocks
+                     if any(callable(v) for _, *vals in b._loads for v in vals)]
+        if fn_loads:
+            warnings.warn(f"save: applied loads given as functions of time ({fn_loads}) are "
+                          "saved as their values now; the loaded simulation keeps them "
+                          "constant", stacklevel=3)
         fixes = f.create_group("fixes")
         for n, (ids, *vals) in enumerate(sim._fixes):
             g = fixes.create_group(f"{n:04d}")
@@ -301,10 +308,10 @@ def _upgrade_v2(state):
     from the kinetic energy then."""
     if "pos" in state and "prop" in state and "vel" in state:
         n = len(state["pos"])
-        work = np.zeros((n, 6))
+        work = np.zeros((n, 7))
         v, prop = state["vel"], state["prop"]
         w = state.get("omega", np.zeros(n))
-        work[:, 5] = 0.5 * (prop[:, 1] * np.einsum("ij,ij->i", v, v) + prop[:, 2] * w * w)
+        work[:, 6] = 0.5 * (prop[:, 1] * np.einsum("ij,ij->i", v, v) + prop[:, 2] * w * w)
         state.setdefault("ework", work)
 
 
@@ -575,6 +582,7 @@ def load(path, arch=None):
             sim._cont.set_non_reflecting(kind, ids, coef)
     sim._last_fit = cfg["last_fit"]
     sim._account0 = cfg.get("account0")
+    sim._loads_on = bool("fext" in state and np.any(state["fext"]))
     if raw["version"] < 3 and sim._cont is not None and sim._cont.nv:
         # no work account before version 3: it starts at the load
         sim._cont.restart_work()

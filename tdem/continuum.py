@@ -50,7 +50,7 @@ _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig",
 # each step that ``elements()`` reads (element areas and N_e: a loaded model reports
 # them before its first step; files without them still load)
 SAVED_DERIVED = ("earea", "ncov")
-SAVED = _SNAP + ("npos0",) + SAVED_DERIVED
+SAVED = _SNAP + ("npos0", "nload") + SAVED_DERIVED
 
 
 @cached
@@ -276,7 +276,8 @@ class Continuum:
         a["nfix"] = ti.ndarray(ti.i32, (nv,))
         # the work done on each node since the start (tdem.nodes.integrate_nodes) and
         # its kinetic energy at the start
-        a["nwork"] = _arr(5, (nv,))
+        a["nwork"] = _arr(6, (nv,))
+        a["nload"] = _arr(2, (nv,))      # applied loads (Block.apply_force, apply_pressure)
         a["tri"] = schema.ndarray(3, ti.i32, (nt,))
         a["tmat"] = ti.ndarray(ti.i32, (nt,))
         a["tsig"] = _arr(4, (nt,))
@@ -295,8 +296,8 @@ class Continuum:
         nvel = np.concatenate([b.velocity for b in self.blocks])
         a["nvel"].from_numpy(nvel)
         a["nmass"].from_numpy(np.concatenate(mass))
-        work = np.zeros((off, 5))
-        work[:, 4] = 0.5 * np.concatenate(mass) * np.einsum("ij,ij->i", nvel, nvel)
+        work = np.zeros((off, 6))
+        work[:, 5] = 0.5 * np.concatenate(mass) * np.einsum("ij,ij->i", nvel, nvel)
         a["nwork"].from_numpy(work)
         a["nsize"].from_numpy(np.concatenate(size))
         a["tri"].from_numpy(t.astype(np.int32))
@@ -308,6 +309,7 @@ class Continuum:
         a["inc"] = ti.ndarray(ti.i32, (len(inc),))
         a["inc"].from_numpy(inc)
         self.apply_node_fixes(0.0, initial=True)
+        self.apply_node_loads(0.0, initial=True)
 
     def _setup_couples(self, couples):
         """Point–edge couples: rows (point, couple) with the blocks' boundary edges,
@@ -418,16 +420,16 @@ class Continuum:
         a["rstate"] = ti.ndarray(ti.f64, (max(len(rows), 1), 6))
         # the work of the nodal forces, gravity and damping since the start, and the
         # kinetic energy at the start (tdem.nodes.integrate_rigid)
-        a["rwork"] = ti.ndarray(ti.f64, (max(len(rows), 1), 4))
+        a["rwork"] = ti.ndarray(ti.f64, (max(len(rows), 1), 5))
         a["rref"] = _arr(2, (max(self.nv, 1),))
         if rows:
             a["rbody"].from_numpy(np.array(rows, float))
             a["rstate"].from_numpy(np.array(state, float))
-            work = np.zeros((len(rows), 4))
+            work = np.zeros((len(rows), 5))
             nwork = a["nwork"].to_numpy()
             for q, (r, st) in enumerate(zip(rows, state)):
-                work[q, 3] = 0.5 * r[2] * (st[2] ** 2 + st[3] ** 2) + 0.5 * r[3] * st[5] ** 2
-                nwork[int(r[0]):int(r[0]) + int(r[1]), 4] = 0.0   # counted with the body
+                work[q, 4] = 0.5 * r[2] * (st[2] ** 2 + st[3] ** 2) + 0.5 * r[3] * st[5] ** 2
+                nwork[int(r[0]):int(r[0]) + int(r[1]), 5] = 0.0   # counted with the body
             a["rwork"].from_numpy(work)
             a["nwork"].from_numpy(nwork)
             ref = np.zeros((self.nv, 2))
@@ -479,6 +481,35 @@ class Continuum:
         self.a["nvfix"].from_numpy(self._nvfix)
         return any_fn
 
+    def apply_node_loads(self, t, initial=False):
+        """Upload the blocks' applied loads (Block.apply_force, apply_pressure) at time
+        t; returns whether some are functions of time (then uploaded every step)."""
+        if self.nv == 0:
+            return False
+        load = np.zeros((self.nv, 2))
+        any_fn = False
+        for b in self.blocks:
+            for ids, *vals in b._loads:
+                g = ids + b._offset
+                if len(vals) == 2 and not (isinstance(vals[0], np.ndarray) and vals[0].ndim == 2):
+                    for col, v in enumerate(vals):
+                        if v is None:
+                            continue
+                        if callable(v):
+                            any_fn = True
+                            v = np.broadcast_to(np.asarray(v(t), float), g.shape)
+                        load[g, col] += v
+                else:
+                    coef, p = vals
+                    if callable(p):
+                        any_fn = True
+                        p = float(p(t))
+                    load[g] += p * coef
+        self.a["nload"].from_numpy(load)
+        if initial:
+            self._load_fn = any_fn
+        return any_fn
+
     # ------------------------------------------------------------------ stepping
     def critical_dt(self):
         """Shortest element altitude / c_p over the initial PCMM elements and the
@@ -490,9 +521,11 @@ class Continuum:
     # ---------------------------------------------------- the stages of one step
     # (the order is in Simulation._one_step; each stage owns what it writes)
     def prescribed(self, sim):
-        """Stage: node velocities prescribed by functions of time, uploaded."""
+        """Stage: node velocities and loads given by functions of time, uploaded."""
         if self._fix_fn_nodes():
             self.apply_node_fixes(sim._time)
+        if self.nv and getattr(self, "_load_fn", False):
+            self.apply_node_loads(sim._time)
 
     def pcmm_elements(self, sim, dt, reach):
         """Stage: PCMM candidates (after a list build) and the element update, forces
@@ -594,10 +627,11 @@ class Continuum:
             a = self.a
             if self.nrigid:
                 integrate_rigid(a["npos"], a["nvel"], a["nforce"], a["nmass"], a["rbody"],
-                                a["rstate"], a["rref"], a["rwork"], sim._a["simp"])
+                                a["rstate"], a["rref"], a["rwork"], a["nload"],
+                                sim._a["simp"])
             integrate_nodes(a["npos"], a["nvel"], a["nmass"], a["nforce"], a["nfix"],
-                            a["nvfix"], a["nsize"], a["nreact"], a["nwork"], sim._a["simp"],
-                            a["nflags"], sim._serial())
+                            a["nvfix"], a["nsize"], a["nreact"], a["nwork"], a["nload"],
+                            sim._a["simp"], a["nflags"], sim._serial())
 
     def status(self):
         """(candidate slots needed, first unstable node or −1)."""
@@ -745,40 +779,41 @@ class Continuum:
         kinetic energy now as the start's)."""
         a = self.a
         v = a["nvel"].to_numpy()
-        nw = np.zeros((len(v), 5))
+        nw = np.zeros((len(v), 6))
         free = (a["nfix"].to_numpy() & RIGID_NODE) == 0
-        nw[:, 4] = np.where(free, 0.5 * a["nmass"].to_numpy() * np.einsum("ij,ij->i", v, v), 0.0)
+        nw[:, 5] = np.where(free, 0.5 * a["nmass"].to_numpy() * np.einsum("ij,ij->i", v, v), 0.0)
         a["nwork"].from_numpy(nw)
         if self.nrigid:
             st = a["rstate"].to_numpy()
             body = a["rbody"].to_numpy()
             rw = np.zeros(a["rwork"].shape)
-            rw[:, 3] = 0.5 * body[:, 2] * (st[:, 2] ** 2 + st[:, 3] ** 2) \
+            rw[:, 4] = 0.5 * body[:, 2] * (st[:, 2] ** 2 + st[:, 3] ** 2) \
                 + 0.5 * body[:, 3] * st[:, 5] ** 2
             a["rwork"].from_numpy(rw)
 
     def work_sums(self):
-        """(work of the nodal forces, gravity, damping, constraints on the block nodes
-        and rigid blocks since the start (J/m), their kinetic energy ½ m v² now at
-        the half step, and at the start)."""
-        w = np.zeros(4)
+        """(work of the nodal forces, gravity, damping, constraints and loads on the
+        block nodes and rigid blocks since the start (J/m), their kinetic energy
+        ½ m v² now at the half step, and at the start)."""
+        w = np.zeros(5)
         ke = ke0 = 0.0
         if self.nv:
             a = self.a
             nw = a["nwork"].to_numpy()
             free = (a["nfix"].to_numpy() & RIGID_NODE) == 0
             v = a["nvel"].to_numpy()[free]
-            w += nw[:, :4].sum(axis=0)
+            w += nw[:, :5].sum(axis=0)
             ke += 0.5 * float(a["nmass"].to_numpy()[free] @ np.einsum("ij,ij->i", v, v))
-            ke0 += float(nw[:, 4].sum())
+            ke0 += float(nw[:, 5].sum())
             if self.nrigid:
                 rw = a["rwork"].to_numpy()[:self.nrigid]
                 st = a["rstate"].to_numpy()[:self.nrigid]
                 body = a["rbody"].to_numpy()[:self.nrigid]
                 w[:3] += rw[:, :3].sum(axis=0)
+                w[4] += rw[:, 3].sum()
                 ke += float(np.sum(0.5 * body[:, 2] * (st[:, 2] ** 2 + st[:, 3] ** 2)
                                    + 0.5 * body[:, 3] * st[:, 5] ** 2))
-                ke0 += float(rw[:, 3].sum())
+                ke0 += float(rw[:, 4].sum())
         return w, ke, ke0
 
     def particle_fields(self):

@@ -74,6 +74,7 @@ class Block:
         self.slot = slot
         self.velocity = velocity
         self._fixes = []
+        self._loads = []      # (node ids, fx, fy) or (node ids, coefficients (k, 2), p)
         self._offset = 0
         self.rigid = False
 
@@ -94,6 +95,52 @@ class Block:
         cont = self._sim._cont
         if cont is not None:
             cont.apply_node_fixes(self._sim.time, initial=True)
+
+    def apply_force(self, nodes, fx=None, fy=None):
+        """Apply forces (N per metre of thickness) to ``nodes`` (indices into the
+        block's vertices): each of fx, fy is None, a float, an array (one per node) or
+        a function of time returning either. Loads add up over calls."""
+        ids = indices("nodes", nodes, len(self.vertices), "vertex")
+        vals = [_fix_value(name, v, ids) for name, v in (("fx", fx), ("fy", fy))]
+        self._add_load((ids, *vals))
+
+    def apply_pressure(self, pressure, nodes):
+        """A pressure (Pa, positive pushing into the block; a float or a function of
+        time) on the boundary edges whose two ends are both among ``nodes`` (e.g.
+        ``block.nodes_in(ymin=0.99)``): p × the edge's length, half to each end, along
+        the edge's inward normal. The edges' directions and lengths are those of the
+        mesh as added (a dead load: the load does not turn with the block)."""
+        ids = indices("nodes", nodes, len(self.vertices), "vertex")
+        if not callable(pressure):
+            try:
+                pressure = float(pressure)
+            except (TypeError, ValueError):
+                raise InputError(f"pressure must be a number (Pa) or a function of time, got "
+                                 f"{pressure!r}") from None
+            if not np.isfinite(pressure):
+                raise InputError(f"pressure must be finite, got {pressure!r}")
+        sel = np.zeros(len(self.vertices), bool)
+        sel[ids] = True
+        edges = _mesh.boundary_edges(self.triangles)
+        edges = edges[sel[edges[:, 0]] & sel[edges[:, 1]]]
+        if len(edges) == 0:
+            raise InputError(f"nodes: no boundary edge has both ends among the {len(ids)} "
+                             "nodes given")
+        d = self.vertices[edges[:, 1]] - self.vertices[edges[:, 0]]
+        # the mesh is to the left of a→b: the inward normal times the length is the
+        # edge turned by +90°
+        inward = np.column_stack([-d[:, 1], d[:, 0]])
+        coef = np.zeros((len(self.vertices), 2))
+        np.add.at(coef, edges[:, 0], 0.5 * inward)
+        np.add.at(coef, edges[:, 1], 0.5 * inward)
+        used = np.unique(edges)
+        self._add_load((used, coef[used], pressure))
+
+    def _add_load(self, entry):
+        self._loads.append(entry)
+        cont = self._sim._cont
+        if cont is not None:
+            cont.apply_node_loads(self._sim.time, initial=True)
 
     def kinematic(self):
         """Whether every node has both velocity components prescribed (the block then

@@ -21,13 +21,15 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                     nmass: ti.types.ndarray(), nforce: ti.types.ndarray(),
                     nfix: ti.types.ndarray(), nvfix: ti.types.ndarray(),
                     nsize: ti.types.ndarray(), nreact: ti.types.ndarray(),
-                    nwork: ti.types.ndarray(), simp: ti.types.ndarray(),
-                    nflags: ti.types.ndarray(), serial: ti.template()):
+                    nwork: ti.types.ndarray(), nload: ti.types.ndarray(),
+                    simp: ti.types.ndarray(), nflags: ti.types.ndarray(),
+                    serial: ti.template()):
     """Block nodes, as the particles in :func:`tdem.step.step`: gravity, local and
     global damping, prescribed velocity components (``nreact`` = the force the
-    constraint applies), leapfrog, the work of each force (``nwork``: the nodal
-    forces, gravity, damping, the constraint). nflags[0] = smallest index of a node
-    with a non-finite state or moving more than half its size in one step."""
+    constraint applies), applied loads (``nload``), leapfrog, the work of each force
+    (``nwork``: the nodal forces, gravity, damping, the constraint, the load).
+    nflags[0] = smallest index of a node with a non-finite state or moving more than
+    half its size in one step."""
     dt = simp[P_DT]
     g = ti.Vector([simp[P_GX], simp[P_GY]])
     alpha = simp[P_ALPHA]
@@ -41,7 +43,8 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
         if (nfix[v] & RIGID_NODE) == 0:   # nodes of rigid blocks move with their body
             m = nmass[v]
             v0 = nvel[v]
-            f = nforce[v] + m * g
+            fl = nload[v]
+            f = nforce[v] + m * g + fl
             v1, fd = damped_leapfrog(v0, f, m, alpha, alpha_l, dt)
             # the reaction balances the physical forces only (damping is not one)
             vfree, fd_free = damped_leapfrog(v0, f, m, alpha, 0.0, dt)
@@ -55,7 +58,7 @@ def integrate_nodes(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             vm = 0.5 * (v0 + v1)
             nwork[v] += ti.Vector([nforce[v].dot(vm) * dt, m * g.dot(vm) * dt,
                                    (fd - alpha * m * 0.5 * (v0 + vdamp)).dot(vm) * dt,
-                                   m * (v1 - vdamp).dot(vm), 0.0])
+                                   m * (v1 - vdamp).dot(vm), fl.dot(vm) * dt, 0.0])
             x1 = npos[v] + v1 * dt
             nvel[v] = v1
             npos[v] = x1
@@ -90,12 +93,13 @@ def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
                     nforce: ti.types.ndarray(), nmass: ti.types.ndarray(),
                     rbody: ti.types.ndarray(), rstate: ti.types.ndarray(),
                     rref: ti.types.ndarray(), rwork: ti.types.ndarray(),
-                    simp: ti.types.ndarray()):
+                    nload: ti.types.ndarray(), simp: ti.types.ndarray()):
     """Rigid blocks: force and moment of their nodes' forces about the centre, plus
     gravity; local and global damping as for particles; leapfrog for the centre and
     the angle; the nodes are then placed rigidly, x = c + R(θ)·r₀, and given the
-    rigid-body velocity v + ω × (x − c). ``rwork``: the work of the nodal forces,
-    gravity and damping, as ``nwork`` of :func:`integrate_nodes`."""
+    rigid-body velocity v + ω × (x − c). ``nload``: loads applied to the nodes.
+    ``rwork``: the work of the nodal forces, gravity, damping and loads, as ``nwork``
+    of :func:`integrate_nodes`."""
     dt = simp[P_DT]
     g = ti.Vector([simp[P_GX], simp[P_GY]])
     alpha = simp[P_ALPHA]
@@ -112,19 +116,24 @@ def integrate_rigid(npos: ti.types.ndarray(), nvel: ti.types.ndarray(),
             w0 = rstate[r, 5]
             fn = ti.Vector([0.0, 0.0])
             mom = 0.0
+            fl = ti.Vector([0.0, 0.0])
+            mload = 0.0
             for q in range(o, o + k):
                 fq = nforce[q]
+                lq = nload[q]
                 d = npos[q] - c
                 fn += fq
                 mom += d[0] * fq[1] - d[1] * fq[0]
-            v1, fd = damped_leapfrog(v0, fn + m * g, m, alpha, alpha_l, dt)
-            w1, md = damped_leapfrog(w0, mom, inertia, alpha, alpha_l, dt)
+                fl += lq
+                mload += d[0] * lq[1] - d[1] * lq[0]
+            v1, fd = damped_leapfrog(v0, fn + fl + m * g, m, alpha, alpha_l, dt)
+            w1, md = damped_leapfrog(w0, mom + mload, inertia, alpha, alpha_l, dt)
             vm = 0.5 * (v0 + v1)
             wm = 0.5 * (w0 + w1)
             w_damp = ((fd - alpha * m * vm).dot(vm) + (md - alpha * inertia * wm) * wm) * dt
-            for c4 in ti.static(range(4)):
-                rwork[r, c4] += ti.Vector([(fn.dot(vm) + mom * wm) * dt, m * g.dot(vm) * dt,
-                                           w_damp, 0.0])[c4]
+            for c5 in ti.static(range(4)):
+                rwork[r, c5] += ti.Vector([(fn.dot(vm) + mom * wm) * dt, m * g.dot(vm) * dt,
+                                           w_damp, (fl.dot(vm) + mload * wm) * dt])[c5]
             c1 = c + v1 * dt
             th = rstate[r, 4] + w1 * dt
             cs = ti.cos(th)

@@ -218,12 +218,13 @@ class Results:
         kinetic_change; contacts (particle pairs and walls); continuum (PCMM elements,
         point–edge contacts and non-reflecting boundaries on particles, the nodal
         forces of blocks); gravity; damping (local and global, ≤ 0); constraints
-        (prescribed velocities); total (their sum); residual."""
+        (prescribed velocities); applied (forces of :meth:`apply_force` and block
+        loads); total (their sum); residual."""
         if not self._built:
             self._build()
         e = self._account_now()
         w = {k: e["W_" + k] for k in ("contacts", "continuum", "gravity", "damping",
-                                      "constraints")}
+                                      "constraints", "applied")}
         out = {"kinetic_change": e["ke_half"] - e["ke_start"], **w}
         out["total"] = float(sum(w.values()))
         out["residual"] = out["kinetic_change"] - out["total"]
@@ -233,7 +234,8 @@ class Results:
         """Every sum the energy and work accounts are made of, now (host floats)."""
         e = dict.fromkeys(("kinetic", "gravitational", "elastic", "strain", "dissipated",
                            "boundary_work", "W_contacts", "W_continuum", "W_gravity",
-                           "W_damping", "W_constraints", "Wp_damping", "Wp_constraints",
+                           "W_damping", "W_constraints", "W_applied", "Wp_damping",
+                           "Wp_constraints",
                            "ke_half", "ke_start", "P_half"), 0.0)
         dt = self._dt_run if getattr(self, "_dt_run", None) else 0.0
         a = self._a
@@ -252,10 +254,10 @@ class Results:
             e["boundary_work"] = float(eacc[:, 1].sum())
             ws = work.sum(axis=0)
             for c, k in enumerate(("contacts", "continuum", "gravity", "damping",
-                                   "constraints")):
+                                   "constraints", "applied")):
                 e["W_" + k] = float(ws[c])
             e["Wp_damping"], e["Wp_constraints"] = float(ws[3]), float(ws[4])
-            e["ke_start"] = float(ws[5])
+            e["ke_start"] = float(ws[6])
             e["ke_half"] = float(0.5 * np.sum(prop[:, 1] * np.einsum("ij,ij->i", v, v)
                                               + prop[:, 2] * w * w))
             # ½ Δt F_n·v_{n+1/2} of the contact and element forces of the last step:
@@ -270,6 +272,7 @@ class Results:
             e["W_gravity"] += float(nw[1])
             e["W_damping"] += float(nw[2])
             e["W_constraints"] += float(nw[3])
+            e["W_applied"] += float(nw[4])
             e["ke_half"] += ke
             e["ke_start"] += ke0
             if self._cont.nv:

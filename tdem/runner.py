@@ -101,9 +101,9 @@ class Runner:
     def _new_rows(self, pos, vel, r, m, inertia, law, shape, angle, omega, cap, capw):
         """State rows of new particles (every saved per-particle and per-slot array)."""
         sizes = self._sizes(len(r), cap, capw, 1, 1, 1)
-        work = np.zeros((len(r), 6))
+        work = np.zeros((len(r), 7))
         # the kinetic energy at the start, ½ m v² + ½ I ω²
-        work[:, 5] = 0.5 * (np.asarray(m) * np.einsum("ij,ij->i", vel, vel)
+        work[:, 6] = 0.5 * (np.asarray(m) * np.einsum("ij,ij->i", vel, vel)
                             + np.asarray(inertia) * omega * omega)
         return schema.fresh_rows(len(r), sizes, {
             "ework": work, "omega": omega,
@@ -169,6 +169,7 @@ class Runner:
         self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.WALL_WIDTH), fresh=True)
         self._fit_grid(force=True)
         self._apply_fixes(initial=True)
+        self._apply_loads(initial=True)
         self._upload_params()
         self._a["flags"][F_REBUILD] = 1
 
@@ -391,13 +392,33 @@ class Runner:
             self._fix_fn = any_fn
         self._a["vfix"].from_numpy(vfix.astype(np.float64 if self._fdt == ti.f64 else np.float32))
 
+    def _apply_loads(self, initial=False, t=None):
+        """Upload the applied forces of particles (the sum of the apply_force calls) at
+        time ``t``; the functions of time are evaluated again at every step."""
+        if not self._loads or not self._n:
+            return
+        t = self._time if t is None else t
+        ext = np.zeros((self._n, 3))
+        any_fn = False
+        for ids, *vals in self._loads:
+            for col, v in enumerate(vals):
+                if v is None:
+                    continue
+                if callable(v):
+                    any_fn = True
+                    v = np.broadcast_to(np.asarray(v(t), dtype=float), ids.shape)
+                ext[ids, col] += v
+        if initial:
+            self._load_fn = any_fn
+        self._a["fext"].from_numpy(ext.astype(np.float64 if self._fdt == ti.f64 else np.float32))
+
     # ------------------------------------------------------------------ stepping
     def _step_args(self):
         # the arrays by name; _one_step appends the last four (detail, continuum, laws,
         # shapes)
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
-                           detail=False, continuum=False, laws=self._law_set,
-                           shapes=False)[:-4]
+                           loads=bool(self._loads_on), detail=False, continuum=False,
+                           laws=self._law_set, shapes=False)[:-4]
 
     def _xforce(self):
         if self._cont is not None:
@@ -450,6 +471,8 @@ class Runner:
         dt = self._dt_run
         if self._n and self._fix_fn:
             self._apply_fixes(t=self._time)
+        if self._load_fn:
+            self._apply_loads(t=self._time)
         if cont is not None:
             cont.prescribed(self)
         # on a GPU the rebuild kernel runs every step and returns at once unless the

@@ -145,6 +145,9 @@ class Simulation(Runner, Results):
         self._shaped_cache = None
         self._nonconv_reported = 0
         self._account0 = None      # the energy account after the first step (Results.energy)
+        self._loads = []           # apply_force calls: (ids, fx, fy, moment)
+        self._loads_on = False     # the step kernel's variant with applied loads
+        self._load_fn = False
         self._slots = []           # (material, tolerance) of PCMM bodies and blocks
         self._blocks = []
         self._cont = None          # Continuum (PCMM elements, blocks) once built
@@ -655,6 +658,19 @@ class Simulation(Runner, Results):
         self._fixes.append((ids, *vals))
         if self._built:
             self._apply_fixes(initial=True)
+
+    def apply_force(self, ids, fx=None, fy=None, moment=None):
+        """Apply forces (N per metre of thickness) and moments (N·m/m) to particles
+        ``ids``. Each of fx, fy, moment is None, a float, an array (one per id) or a
+        function of time returning either; loads add up over calls. Blocks have
+        :meth:`Block.apply_force` and :meth:`Block.apply_pressure`."""
+        ids = indices("ids", ids, self._n)
+        vals = [_fix_value(name, v, ids)
+                for name, v in (("fx", fx), ("fy", fy), ("moment", moment))]
+        self._loads.append((ids, *vals))
+        self._loads_on = True
+        if self._built:
+            self._apply_loads(initial=True)
 
     # ------------------------------------------------------------- properties
     @property

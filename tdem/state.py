@@ -72,10 +72,12 @@ ENGINE = (
     Array("facc", "particle", 3, "f", "scratch", doc="force and moment sums of a step"),
     Array("eacc", "particle", 2, "f", "dynamic", doc="dissipated energy, boundary work (J/m)"),
     Array("estate", "particle", 2, "f", "dynamic", doc="kinetic, gravitational energy at t_n"),
-    Array("ework", "particle", 6, "f", "dynamic",
+    Array("ework", "particle", 7, "f", "dynamic",
           doc="work done since the start by the contacts, the continuum (elements, "
               "point-edge contacts, viscous boundaries), gravity, damping, prescribed "
-              "velocities (J/m); kinetic energy at the start (J/m)"),
+              "velocities, applied forces (J/m); kinetic energy at the start (J/m)"),
+    Array("fext", "particle", 3, "f", "setup",
+          doc="applied force fx, fy (N/m) and moment (N m/m), sim.apply_force"),
     Array("ncnt", "particle", "i", "i32", "dynamic", doc="length of the half list"),
     Array("rcnt", "particle", "i", "i32", "dynamic", doc="length of the reverse list"),
     Array("ncnt_old", "particle", "i", "i32", "scratch", doc="half list before a rebuild"),

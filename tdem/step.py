@@ -233,8 +233,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
-         serial: ti.template(), detail: ti.template(), continuum: ti.template(),
-         laws: ti.template(), shapes: ti.template()):
+         fext: ti.types.ndarray(), serial: ti.template(), loads: ti.template(),
+         detail: ti.template(), continuum: ti.template(), laws: ti.template(),
+         shapes: ti.template()):
     """One step. ``detail`` (a compile-time switch) also stores what only output
     reads: per-contact normals, scalar forces and overlaps, particle forces, and
     the kinetic and gravitational energy at t_n. The host asks for it on the last
@@ -243,7 +244,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     ``continuum`` (compile-time): PCMM particles are present. Their element forces
     of this step (``xforce``, from :func:`physics.pcmm.update`) join the contact
     forces, and pair slots marked in ``cskip`` (particles that share an element)
-    have no DEM contact."""
+    have no DEM contact.
+
+    ``loads`` (compile-time): applied forces and moments (``fext``, from
+    :meth:`tdem.Simulation.apply_force`) act on the particles."""
     n = pos.shape[0]
     cap = nbr.shape[1]
     bits = slot_bits(cap)
@@ -367,6 +371,12 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             fx_cont = xforce[i]
         fc = f
         f += fx_cont
+        tc = tq
+        fa = ti.Vector([0.0, 0.0, 0.0])
+        if ti.static(loads):
+            fa = fext[i]
+            f += ti.Vector([fa[0], fa[1]])
+            tq += fa[2]
         m = prop[i][PROP_MASS]
         inertia = prop[i][PROP_INERTIA]
         v0 = vel[i]
@@ -397,13 +407,14 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         w_damp = ((fd - alpha * m * 0.5 * (v0 + vfree)).dot(vm)
                   + (md - alpha * inertia * 0.5 * (w0 + wfree)) * wm) * dt
         w_fix = m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm
-        ework[i] += ti.Vector([(fc.dot(vm) + tq * wm) * dt, fx_cont.dot(vm) * dt,
-                               m * g.dot(vm) * dt, w_damp, w_fix, 0.0])
+        ework[i] += ti.Vector([(fc.dot(vm) + tc * wm) * dt, fx_cont.dot(vm) * dt,
+                               m * g.dot(vm) * dt, w_damp, w_fix,
+                               (fa[0] * vm[0] + fa[1] * vm[1] + fa[2] * wm) * dt, 0.0])
         if alpha != 0.0 or alpha_l != 0.0 or fx != 0:
             eacc[i] += ti.Vector([-w_damp, w_fix])
         if ti.static(detail):
-            force[i] = f
-            torque[i] = tq
+            force[i] = fc + fx_cont
+            torque[i] = tc
             estate[i] = ti.Vector([0.5 * m * vm.dot(vm) + 0.5 * inertia * wm * wm,
                                    -m * g.dot(x0)])
         x1 = x0 + v1 * dt
