@@ -33,11 +33,12 @@ Read-outs (summary.json)
   flight would set the scale), and, for scale, the P-wave and Rayleigh-wave arrival
   times from the charge's contact point;
 - P4-P6 peak pressures and the ratios P5/P4, P6/P4 beside the paper's;
-- crater at the end (3.6 ms): its width is the span (one diameter per particle)
-  of the run of top-surface particles around the charge that have moved at least
-  one diameter (2R) — thrown out, spalled or driven in; its depth is the largest
-  drop, within that span, of the rock surface made of the particles that moved
-  less than a diameter (highest such particle per column one diameter wide).
+- crater at the end (3.6 ms), from the rock's free surface: per column one
+  diameter wide, the top of the rock body counted up from below (discs above a gap
+  wider than a radius are ejecta in flight, not surface); the crater is the run of
+  columns around the charge whose surface lies more than a radius below the original
+  surface: its width at the top between the crossings of that level, its depth
+  below the original surface.
 
 Presets
 -------
@@ -126,39 +127,70 @@ def build(cfg, arch=None, threads=None):
                 centre=centre, R=R)
 
 
+def surface_profile(x, r, x0, x1, dx):
+    """The free surface of a body of discs (centres x (N, 2), radii r (N,)) as heights
+    over columns of width ``dx`` from ``x0`` to ``x1``: in each column, from the lowest
+    disc up through discs that overlap or touch the one below within a radius (a gap
+    wider than that ends the body), the top of the last one (centre + radius). Discs
+    above a gap (ejecta in flight) are not surface. Returns (column centres, heights);
+    an empty column has height −inf."""
+    edges = np.arange(x0, x1 + 0.5 * dx, dx)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    height = np.full(len(centres), -np.inf)
+    col = np.digitize(x[:, 0], edges) - 1
+    ok = (col >= 0) & (col < len(centres))
+    for k in np.unique(col[ok]):
+        sel = np.flatnonzero(col == k)
+        order = sel[np.argsort(x[sel, 1] - r[sel])]
+        top = x[order[0], 1] + r[order[0]]
+        for i in order[1:]:
+            if x[i, 1] - r[i] > top + r[i]:       # a gap wider than a radius
+                break
+            top = max(top, x[i, 1] + r[i])
+        height[k] = top
+    return centres, height
+
+
+def crater_size(centres, height, level, centre, tol):
+    """Width at the top and depth of the crater in a surface profile: the run of
+    columns around ``centre`` whose surface lies more than ``tol`` below ``level`` (the
+    original surface); its width is the distance between the crossings of
+    ``level − tol`` (interpolated between columns), its depth ``level`` − the lowest
+    surface in it. No such run at ``centre``: (0, 0)."""
+    below = height < level - tol
+    c = int(np.argmin(np.abs(centres - centre)))
+    if not below[c]:
+        return 0.0, 0.0
+    lo = hi = c
+    while lo > 0 and below[lo - 1]:
+        lo -= 1
+    while hi < len(below) - 1 and below[hi + 1]:
+        hi += 1
+
+    def crossing(a, b):
+        """x where the profile passes level − tol between columns a (below) and b."""
+        ya, yb = height[a] - (level - tol), height[b] - (level - tol)
+        if not np.isfinite(yb) or yb == ya:
+            return centres[b]
+        return centres[a] + (centres[b] - centres[a]) * ya / (ya - yb)
+
+    left = crossing(lo, lo - 1) if lo > 0 else centres[lo]
+    right = crossing(hi, hi + 1) if hi < len(below) - 1 else centres[hi]
+    finite = height[lo:hi + 1][np.isfinite(height[lo:hi + 1])]
+    depth = level - (finite.min() if len(finite) else level)
+    return float(right - left), float(depth)
+
+
 def crater(p, m):
-    """Width, depth (m) and the surface profile (bin centres, top heights) of the
-    crater (module docstring)."""
+    """Width, depth (m) and the surface profile (column centres, heights) of the
+    crater: the rock's free surface (:func:`surface_profile`, columns one diameter
+    wide; ejecta above a gap left out), the crater where it lies more than a radius
+    below the original surface (:func:`crater_size`)."""
     R = m["R"]
     ids = m["rock"].ids
-    x = p["position"][ids]
-    x0 = m["x0"]
-    moved = np.linalg.norm(x - x0, axis=1) >= 2 * R
-    # width: the run of top-row particles, around the charge, that moved a diameter
-    top_row = np.flatnonzero(x0[:, 1] > H - 0.5 * R)
-    top_row = top_row[np.argsort(x0[top_row, 0])]
-    gone = moved[top_row]
-    c = int(np.argmin(np.abs(x0[top_row, 0] - W / 2)))
-    # the surface: highest particle that moved less than a diameter, per column
-    bins = np.arange(0.0, W + 2 * R, 2 * R)
-    keep = ~moved
-    which = np.clip(np.digitize(x[keep, 0], bins) - 1, 0, len(bins) - 2)
-    top = np.full(len(bins) - 1, -np.inf)
-    np.maximum.at(top, which, x[keep, 1])
-    centres = 0.5 * (bins[1:] + bins[:-1])
-    top[np.isinf(top)] = 0.0
-    if not gone[c]:
-        return 0.0, 0.0, centres, top
-    lo = hi = c
-    while lo > 0 and gone[lo - 1]:
-        lo -= 1
-    while hi < len(gone) - 1 and gone[hi + 1]:
-        hi += 1
-    x_lo, x_hi = x0[top_row[lo], 0] - R, x0[top_row[hi], 0] + R
-    width = x_hi - x_lo
-    span = (centres >= x_lo) & (centres <= x_hi)
-    depth = H - top[span].min()
-    return float(width), float(depth), centres, top
+    xs, top = surface_profile(p["position"][ids], p["radius"][ids], 0.0, W, 2 * R)
+    width, depth = crater_size(xs, top, H, W / 2, R)
+    return width, depth, xs, np.where(np.isfinite(top), top, 0.0)
 
 
 def run(preset="quick", out=None, arch=None, threads=None, duration=None):
@@ -349,7 +381,7 @@ def plots(snaps, hist, xs, top, out, m, at_end=True):
     # crater profile
     fig, ax = plt.subplots(figsize=(7, 3))
     sel = np.abs(xs - W / 2) < 1.5
-    ax.step(xs[sel], top[sel], where="mid", label="rock surface (particles moved < 2R)")
+    ax.step(xs[sel], top[sel], where="mid", label="rock surface (ejecta left out)")
     ax.axhline(H, color="k", lw=0.6, label="initial surface")
     if at_end:
         ax.axvspan(W / 2 - PAPER["crater_width_m"] / 2, W / 2 + PAPER["crater_width_m"] / 2,

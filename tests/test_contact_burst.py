@@ -79,3 +79,49 @@ def test_whole_run_crater_and_energy(tmp_path):
     c = common.checks_by_name(s)
     assert c["crater_width"]["value"] > 2 * contact_burst.CHARGE_RADIUS
     assert c["crater_depth"]["value"] >= 2 * s["data"]["radius_m"]
+
+
+def _synthetic_surface(width, depth, R=0.02, W=4.0, H=2.0, ejecta=True):
+    """Discs on a square lattice filling the rock below y = H except a parabolic
+    crater (width at the top, depth) at x = W/2, and a cloud of ejecta above the
+    crater with a gap below it."""
+    import numpy as np
+    xs = np.arange(R, W, 2 * R)
+    ys = np.arange(R, H, 2 * R)
+    X, Y = np.meshgrid(xs, ys)
+    x, y = X.ravel(), Y.ravel()
+    u = 2 * (x - W / 2) / width
+    surf = np.where(np.abs(u) < 1, H - depth * (1 - u * u), H)
+    keep = y + R <= surf + 1e-9
+    pts = np.column_stack([x[keep], y[keep]])
+    if ejecta:
+        rng = np.random.default_rng(0)
+        fly = np.column_stack([rng.uniform(W / 2 - width / 3, W / 2 + width / 3, 40),
+                               rng.uniform(H + 0.2, H + 0.6, 40)])
+        pts = np.vstack([pts, fly])
+    return pts, np.full(len(pts), R)
+
+
+@pytest.mark.parametrize("width,depth", [(1.4, 0.35), (0.8, 0.5), (2.2, 0.16)])
+def test_crater_measure_on_a_synthetic_surface(width, depth):
+    """A crater of known width at the top and depth, cut into a lattice of discs of
+    R = 2 cm with ejecta flying above it: the free-surface measure finds the depth
+    within one diameter and the width within one diameter over the wall's slope (the
+    surface is resolved to a diameter in height), the ejecta left out; an intact
+    surface has no crater."""
+    R = 0.02
+    x, r = _synthetic_surface(width, depth, R)
+    xs, top = contact_burst.surface_profile(x, r, 0.0, 4.0, 2 * R)
+    w, d = contact_burst.crater_size(xs, top, 2.0, 2.0, R)
+    # the measure's level is a radius below the surface: the parabola's width there;
+    # the surface is known to a diameter in height, so the width to a diameter over
+    # the crater wall's slope there
+    u = (1 - R / depth) ** 0.5
+    expect_w = width * u
+    slope = 4 * depth * u / width
+    assert w == pytest.approx(expect_w, abs=max(2 * R, 2 * R / slope))
+    assert d == pytest.approx(depth, abs=2 * R)
+    x, r = _synthetic_surface(width, depth, R, ejecta=False)
+    x = x[x[:, 1] < 2.0 - 2 * depth]                # a flat rock, lower
+    xs, top = contact_burst.surface_profile(x, r, 0.0, 4.0, 2 * R)
+    assert contact_burst.crater_size(xs, top, top.max(), 2.0, R) == (0.0, 0.0)
