@@ -186,11 +186,12 @@ class Results:
         dissipated − boundary_work, which is conserved for DEM models; explosive: the
         internal energy Σ E·V0 of JWL particles (not in total).
 
-        integration_error: what the contact and element forces did to the bodies
-        beyond the energy their springs and elements stored and their friction and
-        dashpots dissipated, since the end of the first step, −(W_contacts +
-        W_continuum) − Δ(elastic + strain) − Δ(contact dissipation) + Δ(work of the
-        walls), with the works of :meth:`work`. It is the error of the time
+        integration_error: the energy the time integration made (positive: gained)
+        since the end of the first step: what the contact and element forces did to
+        the bodies beyond what their springs and elements released, their friction
+        and dashpots dissipated and the walls supplied, W_contacts + W_continuum +
+        Δ(elastic + strain) + Δ(contact dissipation) − Δ(work of the walls), with the
+        works of :meth:`work`. It is the error of the time
         integration (second order: it falls as Δt² on smooth motion), plus what is
         dissipated without being booked (viscous element stresses, point–edge
         friction). The booked work runs half a step ahead of the stored energy; that
@@ -291,12 +292,13 @@ class Results:
 
 
 def _integration_error(e, e0):
-    """−ΔW_contacts − ΔW_continuum − Δ(elastic + strain) − Δ(contact dissipation) + Δ(work
-    of the walls), between two accounts of :meth:`Results._account_now`; the particles'
-    damping and constraint work are taken out of ``dissipated`` and ``boundary_work``."""
+    """ΔW_contacts + ΔW_continuum + Δ(elastic + strain) + Δ(contact dissipation) − Δ(work
+    of the walls) − ΔP_half between two accounts of :meth:`Results._account_now` (the
+    energy the integration made: positive when it gained); the particles' damping and
+    constraint work are taken out of ``dissipated`` and ``boundary_work``."""
     def d(k):
         return e[k] - e0[k]
     contact_dissipation = d("dissipated") + d("Wp_damping")
     wall_work = d("boundary_work") - d("Wp_constraints")
-    return -(d("W_contacts") + d("W_continuum")) - d("elastic") - d("strain") \
-        - contact_dissipation + wall_work + d("P_half")
+    return (d("W_contacts") + d("W_continuum")) + d("elastic") + d("strain") \
+        + contact_dissipation - wall_work - d("P_half")
