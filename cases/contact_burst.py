@@ -37,8 +37,9 @@ Read-outs (summary.json)
   diameter wide, the top of the rock body counted up from below (discs above a gap
   wider than a radius are ejecta in flight, not surface); the crater is the run of
   columns around the charge whose surface lies more than a radius below the original
-  surface: its width at the top between the crossings of that level, its depth
-  below the original surface.
+  surface (a heap of debris up to two columns wide on its floor counted in): its
+  width at the top between the crossings of that level, its depth below the
+  original surface.
 
 Presets
 -------
@@ -151,16 +152,25 @@ def surface_profile(x, r, x0, x1, dx):
     return centres, height
 
 
-def crater_size(centres, height, level, centre, tol):
+def crater_size(centres, height, level, centre, tol, bridge=2):
     """Width at the top and depth of the crater in a surface profile: the run of
     columns around ``centre`` whose surface lies more than ``tol`` below ``level`` (the
-    original surface); its width is the distance between the crossings of
-    ``level − tol`` (interpolated between columns), its depth ``level`` − the lowest
-    surface in it. No such run at ``centre``: (0, 0)."""
+    original surface), runs of up to ``bridge`` columns standing higher inside it (a
+    heap of debris on the crater's floor) counted in; its width is the distance
+    between the crossings of ``level − tol`` at its ends (interpolated between
+    columns), its depth ``level`` − the lowest surface in it. No such run within
+    ``bridge`` columns of ``centre``: (0, 0)."""
     below = height < level - tol
+    # close the gaps of up to `bridge` columns between columns below
+    idx = np.flatnonzero(below)
+    for a, b in zip(idx[:-1], idx[1:]):
+        if 1 < b - a <= bridge + 1:
+            below[a:b] = True
     c = int(np.argmin(np.abs(centres - centre)))
-    if not below[c]:
+    near = np.flatnonzero(below[max(c - bridge, 0):c + bridge + 1])
+    if len(near) == 0:
         return 0.0, 0.0
+    c = max(c - bridge, 0) + int(near[np.argmin(np.abs(near + max(c - bridge, 0) - c))])
     lo = hi = c
     while lo > 0 and below[lo - 1]:
         lo -= 1
@@ -176,7 +186,8 @@ def crater_size(centres, height, level, centre, tol):
 
     left = crossing(lo, lo - 1) if lo > 0 else centres[lo]
     right = crossing(hi, hi + 1) if hi < len(below) - 1 else centres[hi]
-    finite = height[lo:hi + 1][np.isfinite(height[lo:hi + 1])]
+    inside = height[lo:hi + 1]
+    finite = inside[np.isfinite(inside) & (inside < level - tol)]
     depth = level - (finite.min() if len(finite) else level)
     return float(right - left), float(depth)
 

@@ -95,6 +95,10 @@ def _synthetic_surface(width, depth, R=0.02, W=4.0, H=2.0, ejecta=True):
     keep = y + R <= surf + 1e-9
     pts = np.column_stack([x[keep], y[keep]])
     if ejecta:
+        # a stack of debris standing on the crater's floor at its centre, touching it
+        floor = H - depth
+        stack = np.column_stack([np.full(12, W / 2 + R), floor + R + 2 * R * np.arange(12)])
+        pts = np.vstack([pts, stack])
         rng = np.random.default_rng(0)
         fly = np.column_stack([rng.uniform(W / 2 - width / 3, W / 2 + width / 3, 40),
                                rng.uniform(H + 0.2, H + 0.6, 40)])
@@ -105,7 +109,8 @@ def _synthetic_surface(width, depth, R=0.02, W=4.0, H=2.0, ejecta=True):
 @pytest.mark.parametrize("width,depth", [(1.4, 0.35), (0.8, 0.5), (2.2, 0.16)])
 def test_crater_measure_on_a_synthetic_surface(width, depth):
     """A crater of known width at the top and depth, cut into a lattice of discs of
-    R = 2 cm with ejecta flying above it: the free-surface measure finds the depth
+    R = 2 cm with ejecta flying above it and a stack of debris standing on its floor:
+    the free-surface measure finds the depth
     within one diameter and the width within one diameter over the wall's slope (the
     surface is resolved to a diameter in height), the ejecta left out; an intact
     surface has no crater."""
