@@ -37,14 +37,15 @@ def shape_of(s, r):
 
 
 @ti.func
-def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
+def shaped_pair(i, k, xi, vi, wi, mi, li, ci, sni, shi, rbi, pos: ti.template(),
                 vel: ti.template(), omega: ti.template(), prop: ti.template(),
                 plaw: ti.template(), angle: ti.template(), shp: ti.template(),
                 lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                 hist: ti.template(), cn: ti.template(), cs: ti.template(),
                 flags: ti.template(), dt, detail: ti.template(), laws: ti.template(), per):
-    """Contact in slot k of particle i (the owner) when either body has a shape;
-    returns (f_i, M_i, M_j, dissipated energy), as :func:`tdem.step.pair_contact`."""
+    """Contact in slot k of particle i (the owner) when either body has a shape
+    (``ci``, ``sni``: the cosine and sine of i's angle); returns (f_i, M_i, M_j,
+    dissipated energy), as :func:`tdem.step.pair_contact`."""
     R = ti.static(history_width(laws))
     PHI = ti.static(R + 4)
     ST = ti.static(R + 5)
@@ -53,6 +54,8 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
     rbj = pj[PROP_RADIUS]
     shj = shape_of(shp[j], rbj)
     thj = angle[j]
+    cj = ti.cos(thj)
+    snj = ti.sin(thj)
     d = image(pos[j] - xi, per)        # j at its image nearest to i
     xj = xi + d
     h = hist[i, k]
@@ -67,8 +70,8 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
     apart = dist >= rbi + rbj
     if not apart and dist > 0.0 and h[ST] <= 0.0:
         dh = d / dist
-        hi, spi = se.support(shi, ti.cos(thi), ti.sin(thi), dh)
-        hj, spj = se.support(shj, ti.cos(thj), ti.sin(thj), -dh)
+        hi, spi = se.support(shi, ci, sni, dh)
+        hj, spj = se.support(shj, cj, snj, -dh)
         apart = hi + hj < dist
     if apart:
         if h[ST] != 0.0:
@@ -79,8 +82,8 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, thi, shi, rbi, pos: ti.template(),
         phi0 = h[PHI]
         if not tracked:
             phi0 = ti.atan2(d[1], d[0])
-        delta, n, p_i, p_j, phi, ok, rho_i, rho_j = se.pair_depth(shi, thi, shj, thj, d,
-                                                                  phi0, tracked, False)
+        delta, n, p_i, p_j, phi, ok, rho_i, rho_j = se.pair_depth(shi, ci, sni, shj, cj, snj,
+                                                                  d, phi0, tracked, False)
         if not ok:
             ti.atomic_add(flags[F_NONCONV], 1)
         u_out = delta

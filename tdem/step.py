@@ -279,8 +279,12 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         thi = 0.0
         shi = ti.Vector([0.0, 0.0, 0.0])
         ishaped = False
+        cthi = 1.0
+        sthi = 0.0
         if ti.static(shapes):
             thi = angle[i]
+            cthi = ti.cos(thi)
+            sthi = ti.sin(thi)
             shi = shape_of(shp[i], pi[PROP_RADIUS])
             ishaped = shp[i][2] > 0.0
         for k in range(ncnt[i]):
@@ -310,7 +314,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if ti.static(shapes):
                     if shaped:
                         fk, mk, mjk, dk = shaped_pair(
-                            i, k, xi, vi, wi, pi[PROP_MASS], li, thi, shi, pi[PROP_RADIUS],
+                            i, k, xi, vi, wi, pi[PROP_MASS], li, cthi, sthi, shi, pi[PROP_RADIUS],
                             pos, vel, omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist,
                             cn, cs, flags, dt, detail, laws, per)
                     else:

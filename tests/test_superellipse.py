@@ -76,8 +76,9 @@ def depth_kernel():
     @ti.kernel
     def k(si: ti.types.vector(3, ti.f64), ti_: ti.f64, sj: ti.types.vector(3, ti.f64),
           tj: ti.f64, d: ti.types.vector(2, ti.f64)) -> ti.types.vector(4, ti.f64):
-        f, u, pi, pj, phi, ok, _, _ = se.pair_depth(si, ti_, sj, tj, d,
-                                                    ti.atan2(d[1], d[0]), False, False)
+        f, u, pi, pj, phi, ok, ri, rj = se.pair_depth(si, ti.cos(ti_), ti.sin(ti_), sj,
+                                                      ti.cos(tj), ti.sin(tj), d,
+                                                      ti.atan2(d[1], d[0]), False, False)
         return ti.Vector([f, u[0], u[1], ti.cast(ok, ti.f64)])
 
     def depth(si, ti_, sj, tj, d):

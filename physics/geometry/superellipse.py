@@ -19,14 +19,14 @@ at 16 angles first. Newton's method on f′ = 0 with the analytic f″ = ρ_i + 
 (ρ the curvature radii) is kept inside the bracket that the signs of f′ build up, with
 a bisection where a step would leave it or not halve f′ (Numerical Recipes' rtsafe: the
 flat sides of n > 2, where ρ → ∞, make f′ behave like a cube root there). It stops
-when the two support points face each other within 1e-9 × the bodies' size (f64;
-1e-4 in f32) or the step is below 1e-13 rad; at most ``ITER_CAP`` evaluations, the
-pairs that stop short are counted (never silent). At the minimum f′ = g, so a
-residual g leaves the depth off by g²/2f″ (about 1e-18 of the size here) and the
-normal by g/f″ rad (1e-9), and a last Newton step taken without another evaluation
-(the support points moved along their tangents by ρ dφ) leaves errors of the order
-of g²: a warm-started contact is mostly done after its first evaluation (1.6 times
-the throughput of a 1e-12 stop on the face-on bed of benchmarks/superellipse.py).
+when the two support points face each other within 1e-6 × the bodies' size (f64;
+0.1 in f32) or the step is below 1e-13 rad; at most ``ITER_CAP`` evaluations, the
+pairs that stop short are counted (never silent). Then a last Newton step is taken
+without another evaluation: φ moves by dφ = −f′/f″, the support points along their
+tangents by ρ dφ, the depth by −f′²/2f″, which leaves errors of the order of dφ²
+(1e-12 of the size): a warm-started contact is mostly done after its first
+evaluation (twice the throughput of a 1e-12 stop without the last step on the
+face-on bed of benchmarks/superellipse.py).
 
 **Contact point and force.** The force acts at the midpoint c of P_i and P_j (the
 disc convention: R − δ/2 from each centre for discs), so that the tangential force
@@ -105,27 +105,23 @@ def support_curv(shp, c, s, u):
         pb = ti.Vector([a * ax, b * by]) / h
         rho = (a * b) ** 2 / (h * h * h)
     else:
-        # with the larger of A = |a u'_x|, B = |b u'_y| as the scale, r = smaller/larger:
-        # h = larger·(1 + r^q)^(1/q), and the support point's components are a or b
-        # times (1/(1 + r^q))^(1/n) and (r^q/(1 + r^q))^(1/n) (by logarithms: two
-        # logarithms and four exponentials)
+        # with the larger of A = |a u'_x|, B = |b u'_y| as the scale, r = smaller/larger
+        # and q = n/(n − 1) = 1 + 1/(n − 1): with t = r^(1/(n−1)), r^q = r t, S = 1 + r t,
+        # h = larger·S^(1/q) = larger·S·S^(−1/n), and the support point's components
+        # are a or b times S^(−1/n) and t S^(−1/n) (two logarithms, two exponentials)
         q = n / (n - 1.0)
         A = ti.abs(a * ub[0])
         B = ti.abs(b * ub[1])
         big = ti.max(A, B)
         r = ti.min(A, B) / big
-        lr = 0.0
-        sr = 0.0
+        t = 0.0
         if r > 0.0:
-            lr = q * ti.log(r)
-            sr = ti.exp(lr)
+            t = ti.exp(ti.log(r) / (n - 1.0))
+        sr = r * t
         ssum = 1.0 + sr
-        ls = ti.log(ssum)
-        h = big * ti.exp(ls / q)
-        fb = ti.exp(-ls / n)
-        fs = 0.0
-        if r > 0.0:
-            fs = ti.exp((lr - ls) / n)
+        fb = ti.exp(-ti.log(ssum) / n)
+        h = big * ssum * fb
+        fs = t * fb
         fx = fb
         fy = fs
         if A < B:
@@ -166,17 +162,13 @@ def _value(si, ci, sni, sj, cj, snj, d, phi, point: ti.template()):
 
 
 @ti.func
-def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
+def pair_depth(si, ci, sni, sj, cj, snj, d, phi0, warm, point: ti.template()):
     """Minimum of the pair function near φ0 (``warm``: the normal angle of the last
-    step, else a scan of SCAN angles picks the start). ``si``/``sj`` the shapes, ``ti_``/
-    ``tj`` their angles, d = x_j − x_i. Newton's method on f′ = 0 with f″ = ρ_i + ρ_j − f,
+    step, else a scan of SCAN angles picks the start). ``si``/``sj`` the shapes, (``ci``,
+    ``sni``) and (``cj``, ``snj``) the cosines and sines of their angles, d = x_j − x_i. Newton's method on f′ = 0 with f″ = ρ_i + ρ_j − f,
     kept inside the bracket [lo, hi] that the signs of f′ build up (a bisection where a
     step would leave it or f″ ≤ 0), each step at most 0.3 rad. Returns (δ, n, p_i, p_j,
     φ, converged, ρ_i, ρ_j)."""
-    ci = ti.cos(ti_)
-    sni = ti.sin(ti_)
-    cj = ti.cos(tj)
-    snj = ti.sin(tj)
     tol = _tol()
     phi = phi0
     if not warm:
@@ -193,7 +185,7 @@ def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
     scale = ti.max(si[0], si[1])
     if ti.static(not point):
         scale += ti.max(sj[0], sj[1])
-    gtol = tol * 10.0 * scale          # the support points face each other to this
+    gtol = tol * 1e4 * scale          # the support points face each other to this
     done = ti.abs(g) <= gtol
     dx = 0.3
     dxold = 0.3
@@ -233,7 +225,7 @@ def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
         f, g, fpp, u, pi, pj, ri, rj = _eval(si, ci, sni, sj, cj, snj, d, phi, point)
         if ti.abs(g) <= gtol or (bracket and ti.abs(dx) <= tol * 1e-3):
             done = True
-    if done and fpp > 0.0 and fpp < 1e29:
+    if done and fpp > 0.0 and fpp < 1e29 and ti.abs(g) < 1e-3 * fpp:
         # the last Newton step without another evaluation: φ moves by −f′/f″, the
         # support points along their tangents by ρ dφ, f by −f′²/2f″ (what is left is
         # of the order of f′², round-off after the stop above)
@@ -242,9 +234,13 @@ def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
         pi += ri * dphi * t
         pj -= rj * dphi * t
         f -= 0.5 * g * dphi
-        u = ti.cos(dphi) * u + ti.sin(dphi) * t
+        # (|dφ| ≤ 1e-3 rad: cos and sin to second order leave 1e-10 of the step's
+        # rotation, which is itself of the order of the stop's tolerance)
+        u = (1.0 - 0.5 * dphi * dphi) * u + dphi * t
+        u /= u.norm()
+        phi += dphi
     # keep the stored angle in (−π, π]
-    phi = ti.atan2(u[1], u[0])
+    phi -= 6.283185307179586 * ti.round(phi / 6.283185307179586)
     return f, u, pi, pj, phi, done, ri, rj
 
 
@@ -252,7 +248,8 @@ def pair_depth(si, ti_, sj, tj, d, phi0, warm, point: ti.template()):
 def point_depth(s, th, xp, phi0):
     """Depth of the point x_p (relative to the centre) inside shape ``s`` turned by
     ``th``: the pair function with h_j = 0. Returns (δ, n, p, converged)."""
-    f, u, p, pj, phi, ok, ri, rj = pair_depth(s, th, s, 0.0, xp, phi0, False, True)
+    f, u, p, pj, phi, ok, ri, rj = pair_depth(s, ti.cos(th), ti.sin(th), s, 1.0, 0.0, xp,
+                                              phi0, False, True)
     return f, u, p, ok
 
 
