@@ -20,7 +20,7 @@ at 16 angles first. Newton's method on f′ = 0 with the analytic f″ = ρ_i + 
 a bisection where a step would leave it or not halve f′ (Numerical Recipes' rtsafe: the
 flat sides of n > 2, where ρ → ∞, make f′ behave like a cube root there). It stops
 when the two support points face each other within 1e-6 × the bodies' size (f64;
-0.1 in f32) or the step is below 1e-13 rad; at most ``ITER_CAP`` evaluations, the
+1e-4 in f32) or the step is below 1e-13 rad; at most ``ITER_CAP`` evaluations, the
 pairs that stop short are counted (never silent). Then a last Newton step is taken
 without another evaluation: φ moves by dφ = −f′/f″, the support points along their
 tangents by ρ dφ, the depth by −f′²/2f″, which leaves errors of the order of dφ²
@@ -185,7 +185,9 @@ def pair_depth(si, ci, sni, sj, cj, snj, d, phi0, warm, point: ti.template()):
     scale = ti.max(si[0], si[1])
     if ti.static(not point):
         scale += ti.max(sj[0], sj[1])
-    gtol = tol * 1e4 * scale          # the support points face each other to this
+    gtol = 1e-6 * scale                # the support points face each other to this
+    if ti.static(impl.get_runtime().default_fp != ti.f64):
+        gtol = 1e-4 * scale
     done = ti.abs(g) <= gtol
     dx = 0.3
     dxold = 0.3
