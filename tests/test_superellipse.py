@@ -133,7 +133,7 @@ def test_curvature_radius_is_the_turn_of_the_support_point(depth_kernel, s):
 
     @ti.kernel
     def rho(sh: ti.types.vector(3, ti.f64), phi: ti.f64) -> ti.f64:
-        _, _, r = se.support_curv(sh, 1.0, 0.0, ti.Vector([ti.cos(phi), ti.sin(phi)]))
+        h, p, r = se.support_curv(sh, 1.0, 0.0, ti.Vector([ti.cos(phi), ti.sin(phi)]))
         return r
 
     for phi in (0.3, 1.0, 2.2, 4.0):
