@@ -119,3 +119,41 @@ def test_pcmm_column_under_a_surface_pressure_reaches_the_static_solution():
     give = total / len(bottom) / E
     expect = -(total / span) * (1 - NU ** 2) / E * height - give
     assert s["displacement"][top, 1].mean() == pytest.approx(expect, rel=0.01)
+
+
+def test_loads_survive_a_checkpoint(tmp_path):
+    """Constant loads on particles and block nodes are kept by a checkpoint: the
+    loaded simulation continues exactly as the saved one."""
+    sim = tdem.Simulation(gravity=(0.0, -9.81), local_damping=0.3)
+    law = tdem.LinearContact(kn=1e6, friction=0.4)
+    g = sim.add_particles([[0.1, 0.25], [0.15, 0.3]], 0.02, density=1000.0, contact=law)
+    v, t = tdem.mesh.rectangle(0.3, 0.1, 4, 2)
+    b = sim.add_block(v, t, material=tdem.Elastic(density=RHO, young=E, poisson=NU))
+    b.fix(b.nodes_in(ymax=1e-9), vx=0.0, vy=0.0)
+    b.apply_pressure(2e3, b.nodes_in(ymin=0.1 - 1e-9))
+    sim.apply_force(g.ids, fx=[1.0, -2.0], moment=0.01)
+    sim.couple(g, b, tdem.PointEdge(kn=1e6, ks=1e6, friction_angle=20.0))
+    sim.run(steps=200)
+    sim.save(tmp_path / "c.h5")
+    other = tdem.Simulation.load(tmp_path / "c.h5")
+    sim.run(steps=200)
+    other.run(steps=200)
+    np.testing.assert_array_equal(sim.particles.numpy()["position"],
+                                  other.particles.numpy()["position"])
+    np.testing.assert_array_equal(b.nodes()["position"], other._blocks[0].nodes()["position"])
+    assert sim.work() == other.work()
+    assert sim.work()["applied"] != 0.0
+
+
+def test_block_loads_are_checked():
+    sim = tdem.Simulation(gravity=(0.0, 0.0))
+    v, t = tdem.mesh.rectangle(0.3, 0.1, 4, 2)
+    b = sim.add_block(v, t, material=tdem.Elastic(density=RHO, young=E, poisson=NU))
+    with pytest.raises(tdem.InputError, match="pressure must be"):
+        b.apply_pressure("high", b.nodes_in(ymin=0.099))
+    with pytest.raises(tdem.InputError, match="no boundary edge"):
+        b.apply_pressure(1e3, b.nodes_in(ymin=0.099)[:1])
+    with pytest.raises(tdem.InputError, match="fy must be"):
+        b.apply_force([0, 1], fy=[1.0, 2.0, 3.0])
+    with pytest.raises(tdem.InputError, match="nodes"):
+        b.apply_force([len(v)], fx=1.0)
