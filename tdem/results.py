@@ -191,10 +191,11 @@ class Results:
         the bodies beyond what their springs and elements released, their friction
         and dashpots dissipated and the walls supplied, W_contacts + W_continuum +
         Δ(elastic + strain) + Δ(contact dissipation) − Δ(work of the walls), with the
-        works of :meth:`work`. It is the error of the time
-        integration (second order: it falls as Δt² on smooth motion), plus what is
-        dissipated without being booked (viscous element stresses, point–edge
-        friction). The booked work runs half a step ahead of the stored energy; that
+        works of :meth:`work`. It is the error of the time integration (second
+        order: it falls as Δt² on smooth motion), less what is dissipated without
+        being booked (viscous element stresses, point–edge friction), and, for
+        continua, the elements' geometric nonlinearity. kinetic and gravitational
+        are the particles' (blocks' nodes are in :meth:`work`). The booked work runs half a step ahead of the stored energy; that
         offset, ½ Δt F·v of the last step, is taken out (for a linear spring the
         line is then zero: the leapfrog keeps its discrete energy exactly)."""
         if not self._built:
