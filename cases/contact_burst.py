@@ -39,7 +39,8 @@ Read-outs (summary.json)
   columns around the charge whose surface lies more than a radius below the original
   surface (a heap of debris up to two columns wide on its floor counted in): its
   width at the top between the crossings of that level, its depth below the
-  original surface.
+  original surface, of the floor's running median over five columns (a crack one
+  or two columns wide is not the floor).
 
 Presets
 -------
@@ -152,14 +153,15 @@ def surface_profile(x, r, x0, x1, dx):
     return centres, height
 
 
-def crater_size(centres, height, level, centre, tol, bridge=2):
+def crater_size(centres, height, level, centre, tol, bridge=2, floor=5):
     """Width at the top and depth of the crater in a surface profile: the run of
     columns around ``centre`` whose surface lies more than ``tol`` below ``level`` (the
     original surface), runs of up to ``bridge`` columns standing higher inside it (a
     heap of debris on the crater's floor) counted in; its width is the distance
     between the crossings of ``level − tol`` at its ends (interpolated between
-    columns), its depth ``level`` − the lowest surface in it. No such run within
-    ``bridge`` columns of ``centre``: (0, 0)."""
+    columns), its depth ``level`` − the lowest surface in it after a running median
+    over ``floor`` columns (a crack one or two columns wide is not the crater's
+    floor). No such run within ``bridge`` columns of ``centre``: (0, 0)."""
     below = height < level - tol
     # close the gaps of up to `bridge` columns between columns below
     idx = np.flatnonzero(below)
@@ -186,9 +188,12 @@ def crater_size(centres, height, level, centre, tol, bridge=2):
 
     left = crossing(lo, lo - 1) if lo > 0 else centres[lo]
     right = crossing(hi, hi + 1) if hi < len(below) - 1 else centres[hi]
-    inside = height[lo:hi + 1]
-    finite = inside[np.isfinite(inside) & (inside < level - tol)]
-    depth = level - (finite.min() if len(finite) else level)
+    half = floor // 2
+    filled = np.where(np.isfinite(height), height, level)
+    padded = np.concatenate([np.full(half, filled[0]), filled, np.full(half, filled[-1])])
+    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * half + 1)
+    smooth = np.median(windows, axis=1)[lo:hi + 1]
+    depth = max(level - smooth.min(), 0.0)
     return float(right - left), float(depth)
 
 

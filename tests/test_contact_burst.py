@@ -99,6 +99,10 @@ def _synthetic_surface(width, depth, R=0.02, W=4.0, H=2.0, ejecta=True):
         floor = H - depth
         stack = np.column_stack([np.full(12, W / 2 + R), floor + R + 2 * R * np.arange(12)])
         pts = np.vstack([pts, stack])
+        # and a crack one column wide, from the floor down to 0.5 m below it, beside it
+        crack = (np.abs(pts[:, 0] - (W / 2 + 5 * R)) < R) & (pts[:, 1] > floor - 0.5) \
+            & (pts[:, 1] < floor - 0.3)
+        pts = pts[~crack]
         rng = np.random.default_rng(0)
         fly = np.column_stack([rng.uniform(W / 2 - width / 3, W / 2 + width / 3, 40),
                                rng.uniform(H + 0.2, H + 0.6, 40)])
@@ -109,8 +113,8 @@ def _synthetic_surface(width, depth, R=0.02, W=4.0, H=2.0, ejecta=True):
 @pytest.mark.parametrize("width,depth", [(1.4, 0.35), (0.8, 0.5), (2.2, 0.16)])
 def test_crater_measure_on_a_synthetic_surface(width, depth):
     """A crater of known width at the top and depth, cut into a lattice of discs of
-    R = 2 cm with ejecta flying above it and a stack of debris standing on its floor:
-    the free-surface measure finds the depth
+    R = 2 cm with ejecta flying above it, a stack of debris standing on its floor and
+    a crack below the floor: the free-surface measure finds the depth
     within one diameter and the width within one diameter over the wall's slope (the
     surface is resolved to a diameter in height), the ejecta left out; an intact
     surface has no crater."""
