@@ -37,13 +37,6 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KEYS = ("position", "velocity", "omega", "angle")
 
 
-def _square(nx, ny, R, origin):
-    xs = origin[0] + 2 * R * np.arange(nx)
-    ys = origin[1] + 2 * R * np.arange(ny)
-    X, Y = np.meshgrid(xs, ys)
-    return np.column_stack([X.ravel(), Y.ravel()])
-
-
 def _laws():
     import tdem
     rolling = tdem.LinearContact(kn=1e6, friction=0.5, restitution=0.5,
@@ -58,6 +51,7 @@ def _everything():
     under a non-reflecting boundary, everything in contact from the first step (the
     charge's small particles set a step of 0.15 µs: nothing would meet in 150 steps)."""
     import tdem
+    from test_state import add_charge_and_blocks
     lin, hertz, plain = _laws()
     R = 0.01
     sim = tdem.Simulation(gravity=(0.0, -9.81), dt_fraction=0.3)
@@ -86,23 +80,7 @@ def _everything():
     rounds = sim.add_particles([[0.335, 2 * box.b + round_.b - 3e-4]], shape=round_,
                                angle=10.0, density=2500.0, contact=hertz, velocity=(0.3, -0.6))
     sim.add_wall((0.0, 0.0), (0.45, 0.0), contact=lin)
-    side = sim.add_wall((0.0, 0.0), (0.0, 0.3), contact=lin)
-    side.velocity = (0.01, 0.0)
-    # an explosive patch, far from the rest, detonated at once
-    tnt = sim.add_particles(_square(3, 3, 0.0025, (1.0, 1.0)), 0.0025, material=tdem.JWL.tnt(),
-                            tolerance=0.0025)
-    sim.detonate(tnt, (1.0, 1.0))
-    # a fixed deformable base block, a rigid block on it, a disc on the base
-    vb, tb = tdem.mesh.rectangle(0.4, 0.05, 8, 1, origin=(0.5, -0.05))
-    base = sim.add_block(vb, tb, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25))
-    base.fix(np.arange(len(vb)), vx=0.0, vy=0.0)
-    vt, tt = tdem.mesh.rectangle(0.05, 0.05, 1, 1, origin=(0.55, -0.0001))
-    rigid = sim.add_block(vt, tt, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25),
-                          rigid=True, velocity=(0.2, 0.0))
-    sim.couple(rigid, base, tdem.PointEdge(friction_angle=25.0))
-    disc = sim.add_particles([[0.75, 0.0099]], R, density=2500.0, contact=lin,
-                             velocity=(-0.1, -0.2))
-    sim.couple(disc, base, tdem.PointEdge(kn=1e6, ks=1e6, friction_angle=20.0))
+    add_charge_and_blocks(sim, lin, R)
     return sim, np.concatenate([boxes.ids, rounds.ids])
 
 

@@ -33,13 +33,19 @@ def _everything():
                            velocity=(0.1, -0.5))
     sim.fix_particles(hz.ids[:1], vx=0.0, omega=1.0)
     sim.add_wall((0.0, 0.0), (0.3, 0.0), contact=lin)
-    side = sim.add_wall((0.0, 0.0), (0.0, 0.3), contact=lin)
+    add_charge_and_blocks(sim, lin, R)
+    return sim
+
+
+def add_charge_and_blocks(sim, law, R):
+    """The rest of the model of every kind: a moving side wall, an explosive patch far
+    from the rest detonated at once, a fixed deformable base block with a rigid block
+    on it (vertex–edge coupling) and a disc of ``law`` on the base (particle–edge)."""
+    side = sim.add_wall((0.0, 0.0), (0.0, 0.3), contact=law)
     side.velocity = (0.01, 0.0)
-    # an explosive patch, far from the rest, detonated at once
     tnt = sim.add_particles(_square(3, 3, 0.0025, (1.0, 1.0)), 0.0025, material=tdem.JWL.tnt(),
                             tolerance=0.0025)
     sim.detonate(tnt, (1.0, 1.0))
-    # a fixed deformable base block, a rigid block on it, a disc on the base
     vb, tb = tdem.mesh.rectangle(0.4, 0.05, 8, 1, origin=(0.5, -0.05))
     base = sim.add_block(vb, tb, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25))
     base.fix(np.arange(len(vb)), vx=0.0, vy=0.0)
@@ -47,10 +53,9 @@ def _everything():
     top = sim.add_block(vt, tt, material=tdem.Elastic(density=2500.0, young=1e8, poisson=0.25), rigid=True,
                         velocity=(0.2, 0.0))
     sim.couple(top, base, tdem.PointEdge(friction_angle=25.0))
-    disc = sim.add_particles([[0.75, 0.0099]], R, density=2500.0, contact=lin,
+    disc = sim.add_particles([[0.75, 0.0099]], R, density=2500.0, contact=law,
                              velocity=(-0.1, -0.2))
     sim.couple(disc, base, tdem.PointEdge(kn=1e6, ks=1e6, friction_angle=20.0))
-    return sim
 
 
 def _arrays(sim):
