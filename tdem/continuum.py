@@ -491,20 +491,13 @@ class Continuum:
         for b in self.blocks:
             for ids, *vals in b._loads:
                 g = ids + b._offset
-                if len(vals) == 2 and not (isinstance(vals[0], np.ndarray) and vals[0].ndim == 2):
-                    for col, v in enumerate(vals):
-                        if v is None:
-                            continue
-                        if callable(v):
-                            any_fn = True
-                            v = np.broadcast_to(np.asarray(v(t), float), g.shape)
-                        load[g, col] += v
-                else:
-                    coef, p = vals
-                    if callable(p):
+                for col, v in enumerate(vals):
+                    if v is None:
+                        continue
+                    if callable(v):
                         any_fn = True
-                        p = float(p(t))
-                    load[g] += p * coef
+                        v = np.broadcast_to(np.asarray(v(t), float), g.shape)
+                    load[g, col] += v
         self.a["nload"].from_numpy(load)
         if initial:
             self._load_fn = any_fn

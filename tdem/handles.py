@@ -74,7 +74,7 @@ class Block:
         self.slot = slot
         self.velocity = velocity
         self._fixes = []
-        self._loads = []      # (node ids, fx, fy) or (node ids, coefficients (k, 2), p)
+        self._loads = []      # (node ids, fx, fy), as fix's (apply_force, apply_pressure)
         self._offset = 0
         self.rigid = False
 
@@ -134,7 +134,12 @@ class Block:
         np.add.at(coef, edges[:, 0], 0.5 * inward)
         np.add.at(coef, edges[:, 1], 0.5 * inward)
         used = np.unique(edges)
-        self._add_load((used, coef[used], pressure))
+        cx, cy = coef[used, 0], coef[used, 1]
+        if callable(pressure):
+            self._add_load((used, lambda t: float(pressure(t)) * cx,
+                            lambda t: float(pressure(t)) * cy))
+        else:
+            self._add_load((used, pressure * cx, pressure * cy))
 
     def _add_load(self, entry):
         self._loads.append(entry)

@@ -157,3 +157,23 @@ def test_block_loads_are_checked():
         b.apply_force([0, 1], fy=[1.0, 2.0, 3.0])
     with pytest.raises(tdem.InputError, match="nodes"):
         b.apply_force([len(v)], fx=1.0)
+
+
+def test_pressure_given_as_a_function_of_time():
+    """p(t) = 2e3·t on the top edge moves the block as the same nodal forces given as
+    functions of time."""
+    out = []
+    for kind in ("pressure", "forces"):
+        sim = tdem.Simulation(gravity=(0.0, 0.0), dt=1e-5)
+        v, t = tdem.mesh.rectangle(0.3, 0.1, 3, 1)
+        b = sim.add_block(v, t, material=tdem.Elastic(density=RHO, young=E, poisson=NU))
+        b.fix(b.nodes_in(ymax=1e-9), vx=0.0, vy=0.0)
+        top = np.sort(b.nodes_in(ymin=0.1 - 1e-9))
+        if kind == "pressure":
+            b.apply_pressure(lambda s: 2e3 * s, top)
+        else:
+            share = np.array([0.05, 0.1, 0.1, 0.05])[np.argsort(np.argsort(v[top, 0]))]
+            b.apply_force(top, fy=lambda s: -2e3 * s * share)
+        sim.run(steps=50)
+        out.append(b.nodes()["position"])
+    np.testing.assert_allclose(out[0], out[1], rtol=0, atol=1e-15)
