@@ -194,10 +194,11 @@ class Results:
         works of :meth:`work`. It is the error of the time integration (second
         order: it falls as Δt² on smooth motion), less what is dissipated without
         being booked (viscous element stresses, point–edge friction), and, for
-        continua, the elements' geometric nonlinearity. kinetic and gravitational
-        are the particles' (blocks' nodes are in :meth:`work`). The booked work runs half a step ahead of the stored energy; that
-        offset, ½ Δt F·v of the last step, is taken out (for a linear spring the
-        line is then zero: the leapfrog keeps its discrete energy exactly)."""
+        continua, the elements' geometric nonlinearity. The booked work runs half a
+        step ahead of the stored energy; that offset, ½ Δt F·v of the last step, is
+        taken out (for a linear spring the line is then zero: the leapfrog keeps its
+        discrete energy exactly). kinetic and gravitational are the particles'
+        (blocks' nodes are in :meth:`work`)."""
         if not self._built:
             self._build()
         e = self._account_now()
@@ -224,7 +225,7 @@ class Results:
         loads); total (their sum); residual."""
         if not self._built:
             self._build()
-        e = self._account_now()
+        e = self._account_now(strain=False)
         w = {k: e["W_" + k] for k in ("contacts", "continuum", "gravity", "damping",
                                       "constraints", "applied")}
         out = {"kinetic_change": e["ke_half"] - e["ke_start"], **w}
@@ -232,8 +233,9 @@ class Results:
         out["residual"] = out["kinetic_change"] - out["total"]
         return out
 
-    def _account_now(self):
-        """Every sum the energy and work accounts are made of, now (host floats)."""
+    def _account_now(self, strain=True):
+        """Every sum the energy and work accounts are made of, now (host floats);
+        ``strain=False`` leaves the strain energy (the elements' pass) at 0."""
         e = dict.fromkeys(("kinetic", "gravitational", "elastic", "strain", "dissipated",
                            "boundary_work", "W_contacts", "W_continuum", "W_gravity",
                            "W_damping", "W_constraints", "W_applied", "Wp_damping",
@@ -268,7 +270,8 @@ class Results:
             e["P_half"] = 0.5 * dt * float(np.sum(np.einsum("ij,ij->i", f, v)
                                                   + a["torque"].to_numpy() * w))
         if self._cont is not None:
-            e["strain"] = self._cont.strain_energy()
+            if strain:
+                e["strain"] = self._cont.strain_energy()
             nw, ke, ke0 = self._cont.work_sums()
             e["W_continuum"] += float(nw[0])
             e["W_gravity"] += float(nw[1])
