@@ -142,6 +142,12 @@ def law_class(name):
 
 # components of a tangent-plane vector: 1 in 2D (along t), 3 in 3D
 TANGENT_2D = 1
+TANGENT_3D = 3
+
+
+def tangent_dim(dim):
+    """Components of a tangent-plane vector in ``dim`` dimensions."""
+    return TANGENT_2D if dim == 2 else TANGENT_3D
 
 
 def history_columns(cls, tdim=TANGENT_2D):
@@ -448,3 +454,29 @@ def remap_history(h, width, tail):
     out[..., :keep] = h[..., :keep]
     out[..., nlaw:] = h[..., nlaw_old:]
     return out
+
+
+def tangential_firsts(cls):
+    """First columns (3D) of a law class's tangent-plane history columns."""
+    cols = history_columns(cls, TANGENT_3D)
+    return tuple(cols[name][0] for name in getattr(cls, "tangential", ()))
+
+
+@ti.func
+def rotate_tangential(laws: ti.template(), lawp: ti.template(), L, h, n):
+    """3D: the history ``h`` with each tangent-plane column of the law of row L turned
+    onto the plane normal to the current normal n, its magnitude kept (PHYSICS §8:
+    the contact plane turns between steps; LIGGGHTS and Yade do the same)."""
+    code = ti.cast(lawp[L, COL_CODE], ti.i32)
+    for c in ti.static(range(len(laws))):
+        if code == c:
+            for first in ti.static(tangential_firsts(laws[c])):
+                v = get_columns(h, first, 3)
+                m2 = v.dot(v)
+                if m2 > 0.0:
+                    p = v - v.dot(n) * n
+                    p2 = p.dot(p)
+                    if p2 > 0.0:
+                        p *= ti.sqrt(m2 / p2)
+                    h = put_columns(h, first, p)
+    return h

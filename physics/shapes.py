@@ -211,12 +211,16 @@ def geometric_potential_contact(si, xi, ti, sj, xj, tj):
     return rho_i + rho_j - d, dc / d       # Eq. 42
 
 
-def mass_properties(rows, density, radius):
+def mass_properties(rows, density, radius, dim=2):
     """(mass, inertia) per unit thickness of particles with host shape ``rows`` (N, 4)
-    = (a, b, n, area), n = 0 for a disc of radius ``radius``."""
+    = (a, b, n, area), n = 0 for a disc of radius ``radius``; in 3D (``dim`` 3) of
+    spheres: 4/3 π R³ ρ and 2/5 m R²."""
     rows = np.asarray(rows, dtype=float).reshape(-1, 4)
     rho = np.asarray(density, dtype=float)
     r = np.asarray(radius, dtype=float)
+    if dim == 3:
+        m = rho * 4.0 / 3.0 * np.pi * r ** 3
+        return m, 0.4 * m * r ** 2
     m = rho * np.pi * r ** 2
     inertia = 0.5 * m * r ** 2
     shaped = rows[:, 2] > 0

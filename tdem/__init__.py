@@ -16,14 +16,14 @@ from physics.rolling import RollingResistance
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 from physics.shapes import Superellipse
 
-from . import mesh, pack
+from . import mesh, pack, surfaces
 from .plot import plot_history
 from .errors import CapacityError, InputError, InstabilityError
-from .simulation import Block, ParticleGroup, Simulation, Wall
+from .simulation import Block, Mesh, ParticleGroup, Simulation, Wall
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "ParticleGroup", "Wall", "Block", "ContactLaw", "register_law",
+__all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces", "ContactLaw", "register_law",
            "LinearContact", "HertzMindlin",
            "RollingResistance", "PointEdge", "Superellipse", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history"]

@@ -36,11 +36,12 @@ import numpy as np
 from .continuum import SAVED as CONTINUUM_SAVED
 from . import mesh as _mesh
 from .errors import InputError
-from .step import W_LAW, WALL_WIDTH
+from .step import T_LAW, W_LAW, wall_width
 
 FORMAT = "tdem-checkpoint"
 VERSION = 3     # 2: particle shapes and angles; two more history columns; 3: work account
 _FIX_NAMES = ("vx", "vy", "omega")
+_FIX_NAMES_3D = ("vx", "vy", "vz", "omega")
 _HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle", "omega")
 
 
@@ -74,6 +75,8 @@ def _config(sim):
         "slots": [{"material": m.to_dict(), "tolerance": t} for m, t in sim._slots],
         "continuum_capacity": int(sim._cont.capacity) if sim._cont is not None else 0,
         "periodic": [None if p is None else [float(p[0]), float(p[1])] for p in sim._periodic],
+        "dim": int(sim.dim),
+        "meshes": [[int(a), int(b)] for a, b in sim._meshes],
         "account0": sim._account0,
         "couples": [{"ids": None if ids is None else [int(i) for i in ids],
                      "a": None if a is None else int(a.index), "block": int(b.index),
@@ -110,7 +113,8 @@ def save(sim, path):
             if chunks:
                 host.create_dataset(k, data=np.concatenate(chunks))
         walls = np.asarray(sim._walls_host, dtype=np.float64)
-        host.create_dataset("walls", data=walls.reshape(len(sim._walls_host), WALL_WIDTH))
+        host.create_dataset("walls", data=walls.reshape(len(sim._walls_host),
+                                                        wall_width(sim.dim)))
         fn_loads = [k for k, (ids, *vals) in enumerate(sim._loads) if any(map(callable, vals))]
         fn_loads += [f"block {b.index}" for b in sim._blocks
                      if any(callable(v) for _, *vals in b._loads for v in vals)]
@@ -122,7 +126,7 @@ def save(sim, path):
         for n, (ids, *vals) in enumerate(sim._fixes):
             g = fixes.create_group(f"{n:04d}")
             g.create_dataset("ids", data=np.asarray(ids, dtype=np.int64))
-            for name, v in zip(_FIX_NAMES, vals):
+            for name, v in zip(_FIX_NAMES if sim.dim == 2 else _FIX_NAMES_3D, vals):
                 if v is None:
                     continue
                 if callable(v):
@@ -291,8 +295,9 @@ def _read(path):
         fg = r.node("fixes")
         for key in r.keys(fg):
             g = r.node(key, fg)
+            names = _FIX_NAMES_3D if cfg.get("dim", 2) == 3 else _FIX_NAMES
             fixes.append((r.array("ids", g), *[r.array(nm, g) if r.has(nm, g) else None
-                                               for nm in _FIX_NAMES]))
+                                               for nm in names]))
     if version < 2:
         _upgrade_v1(state, host)
     if version < 3:
@@ -376,8 +381,13 @@ def _check(r, raw):
     if sizes.ndim != 1 or (sizes.size and (sizes.dtype.kind not in "iu" or sizes.min() < 0)) \
             or int(sizes.sum()) != n:
         r.fail(f"'/host/sizes' {sizes.tolist()[:8]} does not add up to its {n} particles")
+    dim = cfg.get("dim", 2)
+    if dim not in (2, 3):
+        r.fail(f"its config gives dim {dim!r}, expected 2 or 3")
+    WALL_WIDTH = wall_width(dim)
     if n:
-        for k, width in (("pos", 2), ("vel", 2), ("radius", 0), ("density", 0), ("law", 0)):
+        for k, width in (("pos", dim), ("vel", dim), ("radius", 0), ("density", 0),
+                         ("law", 0)):
             if k not in host:
                 r.fail(f"it lacks '/host/{k}'")
             want = (n, width) if width else (n,)
@@ -394,7 +404,7 @@ def _check(r, raw):
         r.fail(f"'/host/walls' has shape {walls.shape}, expected (walls, {WALL_WIDTH})")
     if _first_bad(walls) is not None:
         r.fail(f"'/host/walls' holds non-finite values (wall {_first_bad(walls)[0]})")
-    wl = walls[:, W_LAW]
+    wl = walls[:, W_LAW if dim == 2 else T_LAW]
     if len(walls) and (np.any(wl != np.round(wl)) or wl.min() < 0 or wl.max() >= nlaws):
         r.fail(f"'/host/walls' gives a wall the law {wl.tolist()[:8]}, outside [0, {nlaws})")
     if n:
@@ -429,10 +439,11 @@ def _check(r, raw):
             a, v = schema.BY_NAME[name], state[name]
             if a.owner in lead:
                 want = lead[a.owner]
-                extra = 0 if a.comps in (0, "i") else 1
+                comps = a.comps if a.comps in ("H", "HW") else schema._comps(a, {"dim": dim})
+                extra = 0 if comps in (0, "i") else 1
                 if v.shape[:len(want)] != want or v.ndim != len(want) + extra or (
-                        isinstance(a.comps, int) and extra and v.shape[-1] != a.comps):
-                    wanted = want + ((a.comps,) if isinstance(a.comps, int) and extra else
+                        isinstance(comps, int) and extra and v.shape[-1] != comps):
+                    wanted = want + ((comps,) if isinstance(comps, int) and extra else
                                      ("k",) if extra else ())
                     r.fail(f"'/state/{name}' has shape {v.shape}, expected "
                            f"{tuple(wanted)} for its {n} particles")
@@ -462,7 +473,7 @@ def _check(r, raw):
                 state["wall"].shape[0] < len(walls):
             r.fail(f"'/state/wall' has shape {state['wall'].shape}, expected "
                    f"({max(len(walls), 1)}, {WALL_WIDTH})")
-        for name, size in (("flags", None), ("gridp", 4), ("gridn", 4)):
+        for name, size in (("flags", None), ("gridp", 2 * dim), ("gridn", 4)):
             v = state[name]
             if v.ndim != 1 or (size is not None and v.shape[0] != size):
                 r.fail(f"'/state/{name}' has shape {v.shape}")
@@ -520,7 +531,7 @@ def load(path, arch=None):
                      arch=arch, precision=cfg["precision"],
                      local_damping=cfg["local_damping"], global_damping=cfg["global_damping"],
                      skin=cfg["skin"], check_interval=cfg["check_interval"],
-                     progress=cfg["progress"])
+                     progress=cfg["progress"], dim=cfg.get("dim", 2))
     sim._dt_user = cfg["dt"]
     sim._laws = [ContactLaw.from_dict(d) for d in cfg["laws"]]
     sim._pair_override = {(a, b): c for a, b, c in cfg["pair_override"]}
@@ -549,7 +560,9 @@ def load(path, arch=None):
         ids = np.arange(gd["first"], gd["first"] + gd["count"])
         sim._groups.append(ParticleGroup(sim, ids, sim._laws[gd["law"]], rho))
     sim._walls_host = list(host["walls"])
-    sim._periodic = [None if p is None else tuple(p) for p in cfg.get("periodic", [None, None])]
+    sim._periodic = [None if p is None else tuple(p)
+                     for p in cfg.get("periodic", [None] * sim.dim)]
+    sim._meshes = [tuple(m) for m in cfg.get("meshes", [])]
     sim._fixes = fixes
     sim._n = cfg["n"]
     sim._cap = cfg["cap"]

@@ -16,27 +16,34 @@ from . import step as stepk
 from .errors import InputError
 
 
-def _vector2(name, value):
-    """One 2-vector (gravity, a velocity, a point)."""
+def _vector2(name, value, dim=2):
+    """One 2-vector (gravity, a velocity, a point); a 3-vector with ``dim`` 3."""
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(f"{name} must be two numbers, got {value!r}") from None
-    if a.shape != (2,) or not np.isfinite(a).all():
-        raise InputError(f"{name} must be two finite numbers (x, y), got {value!r}")
+        raise InputError(f"{name} must be {('two', 'three')[dim - 2]} numbers, got "
+                         f"{value!r}") from None
+    if a.shape != (dim,) or not np.isfinite(a).all():
+        raise InputError(f"{name} must be {('two', 'three')[dim - 2]} finite numbers "
+                         f"({('x, y', 'x, y, z')[dim - 2]}), got {value!r}")
     return a
 
 
-def _as_xy(name, value, n=None):
+def _as_xy(name, value, n=None, dim=2):
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         raise InputError(f"{name} must be numbers, got {value!r}") from None
-    if n is not None and a.shape == (2,):
-        a = np.broadcast_to(a, (n, 2)).copy()
-    if a.ndim != 2 or a.shape[1] != 2 or (n is not None and a.shape[0] != n):
-        want = f"({n}, 2)" if n is not None else "(N, 2)"
-        raise InputError(f"{name} must have shape {want} or (2,), got shape {a.shape}")
+    if n is not None and a.shape == (dim,):
+        a = np.broadcast_to(a, (n, dim)).copy()
+    if a.ndim != 2 or a.shape[1] != dim or (n is not None and a.shape[0] != n):
+        want = f"({n}, {dim})" if n is not None else f"(N, {dim})"
+        hint = ""
+        if a.ndim == 2 and a.shape[1] in (2, 3) and a.shape[1] != dim:
+            hint = (f" ({a.shape[1]} columns: a {a.shape[1]}D array in a {dim}D simulation; "
+                    f"tdem.Simulation(dim={a.shape[1]}) takes it)")
+        raise InputError(f"{name} must have shape {want} or ({dim},), got shape "
+                         f"{a.shape}{hint}")
     bad = ~np.isfinite(a).all(axis=1)
     if bad.any():
         k = int(np.argmax(bad))
@@ -310,6 +317,71 @@ class Wall:
 
     def __repr__(self):
         return f"Wall({self.index}, endpoints={self.endpoints.tolist()})"
+
+
+class Mesh:
+    """A rigid triangle-mesh wall (3D). ``velocity`` and ``angular_velocity`` (about
+    :attr:`center`) may be changed between runs; :attr:`force` and :attr:`torque` are
+    what it received in the last step."""
+
+    def __init__(self, sim, index):
+        self._sim = sim
+        self.index = index
+
+    def _rows(self):
+        first, count = self._sim._meshes[self.index]
+        return self._sim._wall_rows()[first:first + count]
+
+    def _set(self, col, v):
+        first, count = self._sim._meshes[self.index]
+        rows = self._sim._wall_rows()
+        rows[first:first + count, col:col + 3] = v
+        self._sim._set_wall_rows(rows)
+
+    @property
+    def velocity(self):
+        return self._rows()[0, stepk.T_VX:stepk.T_VX + 3].copy()
+
+    @velocity.setter
+    def velocity(self, v):
+        self._set(stepk.T_VX, _vector2("velocity", v, 3))
+
+    @property
+    def angular_velocity(self):
+        """Angular velocity (rad/s, a 3-vector) about :attr:`center`."""
+        return self._rows()[0, stepk.T_WX:stepk.T_WX + 3].copy()
+
+    @angular_velocity.setter
+    def angular_velocity(self, w):
+        self._set(stepk.T_WX, _vector2("angular_velocity", w, 3))
+
+    @property
+    def center(self):
+        return self._rows()[0, stepk.T_OX:stepk.T_OX + 3].copy()
+
+    @property
+    def triangles(self):
+        """The triangles' corners now, (T, 3, 3)."""
+        r = self._rows()
+        return np.stack([r[:, stepk.T_AX:stepk.T_AX + 3], r[:, stepk.T_BX:stepk.T_BX + 3],
+                         r[:, stepk.T_CX:stepk.T_CX + 3]], axis=1)
+
+    def _loads(self):
+        first, count = self._sim._meshes[self.index]
+        return self._sim._wall_loads()[first:first + count]
+
+    @property
+    def force(self):
+        """Total contact force (3,) the mesh received in the last step."""
+        return self._loads()[:, :3].sum(axis=0)
+
+    @property
+    def torque(self):
+        """Moment (3,) of the contact forces about :attr:`center` in the last step."""
+        return self._loads()[:, 3:6].sum(axis=0)
+
+    def __repr__(self):
+        return f"Mesh({self.index}, triangles={len(self._rows())})"
 
 
 class _View:

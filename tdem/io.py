@@ -75,8 +75,11 @@ class Monitor:
 
 # ------------------------------------------------------------------ VTU files
 def _xyz(a):
-    """(N, 2) → (N, 3) float64 with z = 0."""
-    a = np.asarray(a, dtype=np.float64).reshape(-1, 2)
+    """(N, 2) → (N, 3) float64 with z = 0; (N, 3) (3D) as it is."""
+    a = np.asarray(a, dtype=np.float64)
+    if a.ndim == 2 and a.shape[1] == 3:
+        return a
+    a = a.reshape(-1, 2)
     return np.concatenate([a, np.zeros((len(a), 1))], axis=1)
 
 
@@ -137,6 +140,8 @@ def write_particles_vtu(sim, path, particles=None):
     """
     p = sim.particles.numpy() if particles is None else particles
     n = len(p["radius"])
+    if getattr(sim, "dim", 2) == 3:
+        return _write_spheres_vtu(path, p)
     st = np.zeros((n, 3, 3))
     st[:, :2, :2] = p["stress"]
     st[:, 2, 2] = p["stress_zz"]
@@ -167,6 +172,48 @@ def write_particles_vtu(sim, path, particles=None):
                                          np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)], 1)
     _write_mesh(path, _xyz(p["position"]), [("vertex", np.arange(n, dtype=np.int64)[:, None])],
                 point_data=point_data)
+    return path
+
+
+def _write_spheres_vtu(path, p):
+    """3D: one ``vertex`` cell per sphere with its ``radius`` and ``diameter``
+    (ParaView: Glyph of Sphere scaled by diameter — the glyph's radius is 0.5 — or
+    Point Gaussian), ``velocity``, ``omega``, ``orientation`` (unit quaternion w, x, y,
+    z), ``force``, ``torque`` and ``displacement`` as 3-vectors."""
+    n = len(p["radius"])
+    point_data = {
+        "id": np.arange(n, dtype=np.int64),
+        "radius": np.asarray(p["radius"], dtype=np.float64),
+        "diameter": 2.0 * np.asarray(p["radius"], dtype=np.float64),
+        "mass": np.asarray(p["mass"], dtype=np.float64),
+        "velocity": _xyz(p["velocity"]),
+        "omega": _xyz(p["omega"]),
+        "orientation": np.asarray(p["orientation"], dtype=np.float64).reshape(-1, 4),
+        "force": _xyz(p["force"]),
+        "torque": _xyz(p["torque"]),
+        "displacement": _xyz(p["displacement"]),
+    }
+    _write_mesh(path, _xyz(p["position"]), [("vertex", np.arange(n, dtype=np.int64)[:, None])],
+                point_data=point_data)
+    return path
+
+
+def write_meshes_vtu(sim, path):
+    """3D: the mesh walls to ``path``, one ``triangle`` cell per triangle. Cell data:
+    ``mesh`` (its index), ``force`` (N, received by the triangle in the last step),
+    ``velocity`` (m/s, translation)."""
+    from .step import T_AX, T_BX, T_CX, T_MESH, T_VX, TRI_WIDTH
+    tri = np.asarray(sim._wall_rows(), dtype=np.float64).reshape(-1, TRI_WIDTH)
+    pts = np.stack([tri[:, T_AX:T_AX + 3], tri[:, T_BX:T_BX + 3], tri[:, T_CX:T_CX + 3]],
+                   axis=1).reshape(-1, 3)
+    loads = np.asarray(sim._wall_loads(), dtype=np.float64).reshape(-1, 7)
+    cell_data = {
+        "mesh": [tri[:, T_MESH].astype(np.int64)],
+        "force": [loads[:, :3].copy()],
+        "velocity": [tri[:, T_VX:T_VX + 3].copy()],
+    }
+    _write_mesh(path, pts, [("triangle", np.arange(len(pts), dtype=np.int64).reshape(-1, 3))],
+                cell_data=cell_data)
     return path
 
 
@@ -291,8 +338,10 @@ def write_walls_vtu(sim, path):
 
     Cell data: ``id`` (wall index), ``force`` (N, the total contact force the wall
     received in the last step, z = 0), ``moment`` (N·m about the wall's centre) and
-    ``velocity`` (m/s, translation).
+    ``velocity`` (m/s, translation). In 3D the mesh walls (:func:`write_meshes_vtu`).
     """
+    if getattr(sim, "dim", 2) == 3:
+        return write_meshes_vtu(sim, path)
     walls = sim.walls
     pts = np.concatenate([w.endpoints for w in walls]) if walls else np.zeros((0, 2))
     lines = np.arange(2 * len(walls), dtype=np.int64).reshape(-1, 2)
@@ -321,26 +370,28 @@ def write_contacts_vtu(sim, path, particles=None):
     """
     c = sim.contacts.numpy()
     p = sim.particles.numpy() if particles is None else particles
-    pos = np.asarray(p["position"], dtype=np.float64).reshape(-1, 2)
+    d = getattr(sim, "dim", 2)
+    pos = np.asarray(p["position"], dtype=np.float64).reshape(-1, d)
     pairs = np.asarray(c["pairs"], dtype=np.int64).reshape(-1, 2)
     m = len(pairs)
-    a = pos[pairs[:, 0]] if m else np.zeros((0, 2))
-    b = np.zeros((m, 2))
+    a = pos[pairs[:, 0]] if m else np.zeros((0, d))
+    b = np.zeros((m, d))
     to_particle = pairs[:, 1] >= 0
     b[to_particle] = pos[pairs[to_particle, 1]]
     if any(p is not None for p in getattr(sim, "_periodic", ())):
         # to j's image nearest to i (across a periodic boundary)
         b[to_particle] = a[to_particle] + sim._image(b[to_particle] - a[to_particle])
-    b[~to_particle] = np.asarray(c["point"]).reshape(-1, 2)[~to_particle]
-    pts = np.empty((2 * m, 2))
+    b[~to_particle] = np.asarray(c["point"]).reshape(-1, d)[~to_particle]
+    pts = np.empty((2 * m, d))
     pts[0::2] = a
     pts[1::2] = b
     fn = np.asarray(c["normal"], dtype=np.float64)
     cell_data = {
         "pair": [pairs],
         "normal_force": [fn],
-        "shear_force": [np.asarray(c["shear"], dtype=np.float64)],
-        "moment": [np.asarray(c["moment"], dtype=np.float64)],
+        "shear_force": [np.asarray(c["shear_force"] if d == 3 else c["shear"],
+                                   dtype=np.float64)],
+        "moment": [np.asarray(c["moment"] if d == 2 else np.zeros(m), dtype=np.float64)],
         "overlap": [np.asarray(c["overlap"], dtype=np.float64)],
         "direction": [_xyz(c["direction"])],
     }

@@ -29,6 +29,7 @@ simulation grows the arrays and redoes the steps since its last check.
 import taichi as ti
 
 from physics.contact_law import zero_history
+from physics.geometry import sphere_triangle
 
 from .launch import cached
 from .state import PROP_RADIUS
@@ -45,7 +46,56 @@ FLAGS_SIZE = 8
 # columns of the float parameter array ``simp`` (the step's and the search's)
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
 P_PX0, P_PLX, P_PY0, P_PLY = 7, 8, 9, 10      # periodic axes: start, length (0: none)
-SIMP_SIZE = 12
+P_GZ, P_PZ0, P_PLZ = 11, 12, 13                # 3D: gravity, periodic z axis
+SIMP_SIZE = 16
+
+
+@ti.func
+def gravity(simp: ti.template(), dim: ti.template()):
+    """The gravity vector of the parameter array."""
+    if ti.static(dim == 2):
+        return ti.Vector([simp[P_GX], simp[P_GY]])
+    else:
+        return ti.Vector([simp[P_GX], simp[P_GY], simp[P_GZ]])
+
+
+@ti.func
+def periodic_axes(simp: ti.template(), dim: ti.template()):
+    """(x0, Lx, y0, Ly[, z0, Lz]): the start and length of each axis's period, a length
+    0 where the axis is not periodic."""
+    if ti.static(dim == 2):
+        return ti.Vector([simp[P_PX0], simp[P_PLX], simp[P_PY0], simp[P_PLY]])
+    else:
+        return ti.Vector([simp[P_PX0], simp[P_PLX], simp[P_PY0], simp[P_PLY], simp[P_PZ0],
+                          simp[P_PLZ]])
+
+
+# 3D: the columns of a mesh triangle's row of the wall table (tdem.step): vertices
+# a, b, c, translation velocity, angular velocity, centre of rotation (the mesh's),
+# law, displacement since the lists were built, mesh index
+(T_AX, T_BX, T_CX, T_VX, T_WX, T_OX) = (0, 3, 6, 9, 12, 15)
+T_LAW, T_DISP, T_MESH = 18, 19, 20
+TRI_WIDTH = 21
+
+
+@ti.func
+def wall_offset(wall: ti.template(), w, x):
+    """From x to the nearest point of wall w: a segment (2D, clamped to its ends) or a
+    mesh triangle (3D)."""
+    d = x * 0.0
+    if ti.static(x.n == 2):
+        a = ti.Vector([wall[w, 0], wall[w, 1]])
+        b = ti.Vector([wall[w, 2], wall[w, 3]])
+        ab = b - a
+        sp = ti.math.clamp((x - a).dot(ab) * wall[w, 10], 0.0, 1.0)
+        d = a + sp * ab - x
+    else:
+        q, feat = sphere_triangle.closest_point(
+            x, ti.Vector([wall[w, T_AX], wall[w, T_AX + 1], wall[w, T_AX + 2]]),
+            ti.Vector([wall[w, T_BX], wall[w, T_BX + 1], wall[w, T_BX + 2]]),
+            ti.Vector([wall[w, T_CX], wall[w, T_CX + 1], wall[w, T_CX + 2]]))
+        d = q - x
+    return d
 
 
 @ti.func
@@ -59,23 +109,34 @@ def slot_bits(cap):
 
 
 @ti.func
-def cell_of(x, gridp: ti.template(), nx: ti.i32, ny: ti.i32):
-    """The cell (cx, cy) of point x: cells of side gridp[2] along x and gridp[3] along y
-    from the corner (gridp[0], gridp[1]), clamped to the grid."""
-    cx = ti.cast(ti.floor((x[0] - gridp[0]) / gridp[2]), ti.i32)
-    cy = ti.cast(ti.floor((x[1] - gridp[1]) / gridp[3]), ti.i32)
-    return ti.math.clamp(cx, 0, nx - 1), ti.math.clamp(cy, 0, ny - 1)
+def cell_of(x, gridp: ti.template(), gridn: ti.template()):
+    """The cell (cx, cy[, cz]) of point x, as a vector: cells of side gridp[d + k] along
+    axis k from the corner (gridp[0], … gridp[d − 1]), clamped to the grid of
+    gridn[k] cells along axis k."""
+    c = ti.Vector([0 for _ in ti.static(range(x.n))])
+    for k in ti.static(range(x.n)):
+        c[k] = ti.math.clamp(ti.cast(ti.floor((x[k] - gridp[k]) / gridp[x.n + k]), ti.i32),
+                             0, gridn[k] - 1)
+    return c
+
+
+@ti.func
+def cell_index(c, gridn: ti.template()):
+    """The linear index of cell c (x fastest)."""
+    idx = c[0] + gridn[0] * c[1]
+    if ti.static(c.n == 3):
+        idx += gridn[0] * gridn[1] * c[2]
+    return idx
 
 
 @ti.func
 def image(d, per):
-    """The nearest periodic image of the offset d: per = (x0, Lx, y0, Ly), a length 0
-    where the axis is not periodic (PHYSICS §8: contacts across the boundary are
-    between images)."""
-    if per[1] > 0.0:
-        d[0] -= per[1] * ti.round(d[0] / per[1])
-    if per[3] > 0.0:
-        d[1] -= per[3] * ti.round(d[1] / per[3])
+    """The nearest periodic image of the offset d: per = (x0, Lx, y0, Ly[, z0, Lz]), a
+    length 0 where the axis is not periodic (PHYSICS §8: contacts across the boundary
+    are between images)."""
+    for k in ti.static(range(d.n)):
+        if per[2 * k + 1] > 0.0:
+            d[k] -= per[2 * k + 1] * ti.round(d[k] / per[2 * k + 1])
     return d
 
 
@@ -90,14 +151,17 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             gridp: ti.types.ndarray(), gridn: ti.types.ndarray(), flags: ti.types.ndarray(),
             wall: ti.types.ndarray(), wid: ti.types.ndarray(), whist: ti.types.ndarray(),
             wid_old: ti.types.ndarray(), whist_old: ti.types.ndarray(), nwalls: ti.i32,
-            skin: ti.f64, simp: ti.types.ndarray()):
+            skin: ti.f64, simp: ti.types.ndarray(), dim: ti.template()):
     n = pos.shape[0]
     cap = nbr.shape[1]
     nx = gridn[0]
     ny = gridn[1]
     # periodic axes (their cells tile the period exactly; tdem.runner._fit_grid)
-    per = ti.Vector([simp[P_PX0], simp[P_PLX], simp[P_PY0], simp[P_PLY]])
+    per = periodic_axes(simp, dim)
     ncell = nx * ny
+    if ti.static(dim == 3):
+        ncell *= gridn[2]
+    nrows = ncell // nx
     # 1. keep the old lists (for the history), clear the cell counts
     for i in range(n):
         if flags[F_REBUILD] != 0:
@@ -111,12 +175,11 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
     # 2. count particles per cell
     for i in range(n):
         if flags[F_REBUILD] != 0:
-            cx, cy = cell_of(pos[i], gridp, nx, ny)
-            c = cy * nx + cx
+            c = cell_index(cell_of(pos[i], gridp, gridn), gridn)
             pcell[i] = c
             ti.atomic_add(cell_count[c], 1)
     # 3. exclusive prefix sum: rows in parallel, then row offsets serially
-    for r in range(ny):
+    for r in range(nrows):
         if flags[F_REBUILD] != 0:
             s = 0
             for cx in range(nx):
@@ -125,7 +188,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                 s += cell_count[c]
             cell_start[ncell + r] = s  # row totals stored past the cells
     ti.loop_config(serialize=True)
-    for r in range(ny):
+    for r in range(nrows):
         if flags[F_REBUILD] != 0:
             if r == 0:
                 gridn[3] = 0
@@ -147,19 +210,20 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
         if flags[F_REBUILD] != 0:
             xi = pos[i]
             ri = prop[i][PROP_RADIUS]
-            cx, cy = cell_of(xi, gridp, nx, ny)
+            ci = cell_of(xi, gridp, gridn)
             cnt = 0
             back = 0
-            for dy in ti.static(range(-1, 2)):
-                for dx in ti.static(range(-1, 2)):
-                    ccx = cx + dx
-                    ccy = cy + dy
-                    if per[1] > 0.0:
-                        ccx = (ccx + nx) % nx
-                    if per[3] > 0.0:
-                        ccy = (ccy + ny) % ny
-                    if 0 <= ccx < nx and 0 <= ccy < ny:
-                        c = ccy * nx + ccx
+            for off in ti.static(ti.grouped(ti.ndrange(*([(-1, 2)] * dim)))):
+                if True:
+                    cc = ci + off
+                    inside = True
+                    for ax in ti.static(range(dim)):
+                        if per[2 * ax + 1] > 0.0:
+                            cc[ax] = (cc[ax] + gridn[ax]) % gridn[ax]
+                        if cc[ax] < 0 or cc[ax] >= gridn[ax]:
+                            inside = False
+                    if inside:
+                        c = cell_index(cc, gridn)
                         for s in range(cell_start[c], cell_start[c] + cell_count[c]):
                             j = sorted_ids[s]
                             if j != i:
@@ -222,11 +286,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             cut = prop[i][PROP_RADIUS] + skin
             cnt = 0
             for w in range(nwalls):
-                a = ti.Vector([wall[w, 0], wall[w, 1]])
-                b = ti.Vector([wall[w, 2], wall[w, 3]])
-                ab = b - a
-                sp = ti.math.clamp((xi - a).dot(ab) * wall[w, 10], 0.0, 1.0)
-                d = a + sp * ab - xi
+                d = wall_offset(wall, w, xi)
                 if d.dot(d) < cut * cut:
                     if cnt < capw:
                         h = zero_history(whist[i, 0])
@@ -243,7 +303,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
     ti.loop_config(serialize=True)
     for w in range(nwalls):
         if flags[F_REBUILD] != 0:
-            wall[w, 11] = 0.0
+            wall[w, ti.static(11 if dim == 2 else T_DISP)] = 0.0
     ti.loop_config(serialize=True)
     for _ in range(1):
         if flags[F_REBUILD] != 0:
@@ -252,18 +312,18 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
 
 
 @ti.kernel
-def bounds(pos: ti.types.ndarray(), prop: ti.types.ndarray(), out: ti.types.ndarray()):
-    """out = (xmin, ymin, xmax, ymax, rmax) over finite positions."""
-    out[0] = 1e300
-    out[1] = 1e300
-    out[2] = -1e300
-    out[3] = -1e300
-    out[4] = 0.0
+def bounds(pos: ti.types.ndarray(), prop: ti.types.ndarray(), out: ti.types.ndarray(),
+           dim: ti.template()):
+    """out = (lower corner, upper corner, rmax) over finite positions: (xmin, ymin,
+    xmax, ymax, rmax) in 2D."""
+    for k in ti.static(range(dim)):
+        out[k] = 1e300
+        out[dim + k] = -1e300
+    out[2 * dim] = 0.0
     for i in range(pos.shape[0]):
         x = pos[i]
-        if ti.abs(x[0]) < 1e200 and ti.abs(x[1]) < 1e200:
-            ti.atomic_min(out[0], x[0])
-            ti.atomic_min(out[1], x[1])
-            ti.atomic_max(out[2], x[0])
-            ti.atomic_max(out[3], x[1])
-        ti.atomic_max(out[4], prop[i][PROP_RADIUS])
+        if ti.abs(x).max() < 1e200:
+            for k in ti.static(range(dim)):
+                ti.atomic_min(out[k], x[k])
+                ti.atomic_max(out[dim + k], x[k])
+        ti.atomic_max(out[2 * dim], prop[i][PROP_RADIUS])

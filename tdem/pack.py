@@ -603,12 +603,19 @@ def largest_overlap(positions, radii, among=None):
     """The largest overlap of two discs relative to the smaller radius, and the pair:
     (u / min(R_i, R_j), i, j), (0.0, -1, -1) when none touch; ``among`` (a boolean
     mask): only pairs with at least one disc in it."""
-    x = np.asarray(positions, dtype=float).reshape(-1, 2)
+    x = np.asarray(positions, dtype=float)
+    x = x.reshape(-1, x.shape[-1] if x.ndim == 2 and x.shape[-1] == 3 else 2)
     r = np.asarray(radii, dtype=float).reshape(-1)
     if len(x) < 2:
         return 0.0, -1, -1
     h = 2.0 * float(r.max())
-    i, j = _pairs(x, h, h)
+    if x.shape[1] == 3:
+        from scipy.spatial import cKDTree
+
+        ij = cKDTree(x).query_pairs(h, output_type="ndarray")
+        i, j = ij[:, 0], ij[:, 1]
+    else:
+        i, j = _pairs(x, h, h)
     if among is not None:
         keep = among[i] | among[j]
         i, j = i[keep], j[keep]

@@ -26,6 +26,8 @@ class Results:
         """Particle state; ``stress=False`` skips the stress (computed from the contacts)."""
         if not self._built:
             self._build()
+        if self.dim == 3:
+            return self._particles_numpy_3d()
         if self._n == 0:
             z2 = np.zeros((0, 2))
             z = np.zeros(0)
@@ -79,17 +81,38 @@ class Results:
                 out["pressure"][dem] = -(st[dem, 0, 0] + st[dem, 1, 1]) / 2.0
         return out
 
+    def _particles_numpy_3d(self):
+        """Particle state of a 3D simulation (API.md): position, velocity, omega (N, 3),
+        orientation (N, 4) unit quaternions (w, x, y, z), radius, mass, force, torque
+        (N, 3), displacement (N, 3)."""
+        if self._n == 0:
+            z3 = np.zeros((0, 3))
+            z = np.zeros(0)
+            return {"position": z3, "velocity": z3, "omega": z3, "orientation": np.zeros((0, 4)),
+                    "radius": z, "mass": z, "force": z3, "torque": z3, "displacement": z3}
+        a = self._a
+        prop = a["prop"].to_numpy()
+        pos = a["pos"].to_numpy()
+        return {
+            "position": pos, "velocity": a["vel"].to_numpy(), "omega": a["omega"].to_numpy(),
+            "orientation": a["angle"].to_numpy(),
+            "radius": prop[:, 0].copy(), "mass": prop[:, 1].copy(),
+            "force": a["force"].to_numpy(), "torque": a["torque"].to_numpy(),
+            "displacement": pos - a["pos0"].to_numpy(),
+        }
+
     def _contacts_numpy(self):
         """Contacts in force now: pairs (C,2) (j = -1 - wall index for walls), normal (C,)
         compression-positive, shear (C,), moment (C,) (rolling couple on the first),
         direction (C,2) the unit normal, overlap (C,), point (C,2)."""
         if not self._built:
             self._build()
+        d = self.dim
         if self._n == 0:
             return {"pairs": np.zeros((0, 2), np.int64), "normal": np.zeros(0),
                     "shear": np.zeros(0), "moment": np.zeros(0),
-                    "direction": np.zeros((0, 2)), "overlap": np.zeros(0),
-                    "point": np.zeros((0, 2))}
+                    "direction": np.zeros((0, d)), "overlap": np.zeros(0),
+                    "point": np.zeros((0, d))}
         a = self._a
         cs = a["cs"].to_numpy()
         nbr = a["nbr"].to_numpy()
@@ -111,6 +134,25 @@ class Results:
         wpts = pos[wi] + self._arms(wi, wn, wu, r)
         whist = a["whist"].to_numpy()
         R = _claw.history_width(self._law_set)     # the rolling couple's column
+        if d == 3:
+            # (API.md) the tangential force as a vector: the spring's 3 columns
+            T = _claw.tangent_dim(3)
+            cf = a["cf"].to_numpy()[ii, kk, :3]
+            wcf = a["wcf"].to_numpy()[wi, wk, :3]
+            fs = np.concatenate([cf + cs[ii, kk, 0][:, None] * normal_dir,
+                                 wcf + wcs[wi, wk, 0][:, None] * wn])
+            return {
+                "pairs": np.concatenate([np.stack([ii, jj], 1),
+                                         np.stack([wi, -1 - wid[wi, wk]], 1)]).astype(np.int64),
+                "normal": np.concatenate([cs[ii, kk, 0], wcs[wi, wk, 0]]),
+                "normal_force": np.concatenate([cs[ii, kk, 0], wcs[wi, wk, 0]]),
+                "shear": np.concatenate([cs[ii, kk, 1], wcs[wi, wk, 1]]),
+                "shear_force": fs,
+                "direction": np.concatenate([normal_dir, wn]),
+                "overlap": np.concatenate([u, wu]),
+                "point": np.concatenate([pts, wpts]),
+                "spring": np.concatenate([hist[ii, kk, :T], whist[wi, wk, :T]]),
+            }
         return {
             "pairs": np.concatenate([np.stack([ii, jj], 1),
                                      np.stack([wi, -1 - wid[wi, wk]], 1)]).astype(np.int64),
@@ -253,7 +295,7 @@ class Results:
             e["kinetic"] = float(estate[:, 0].sum())
             e["gravitational"] = float(estate[:, 1].sum())
             e["elastic"] = float(stepk.elastic_energy_sum(*schema.bind(
-                stepk.elastic_energy_sum, a, laws=self._law_set)))
+                stepk.elastic_energy_sum, a, laws=self._law_set, dim=self.dim)))
             e["dissipated"] = float(eacc[:, 0].sum())
             e["boundary_work"] = float(eacc[:, 1].sum())
             ws = work.sum(axis=0)
@@ -262,13 +304,15 @@ class Results:
                 e["W_" + k] = float(ws[c])
             e["Wp_damping"], e["Wp_constraints"] = float(ws[3]), float(ws[4])
             e["ke_start"] = float(ws[6])
+            w2 = w * w if w.ndim == 1 else np.einsum("ij,ij->i", w, w)
             e["ke_half"] = float(0.5 * np.sum(prop[:, 1] * np.einsum("ij,ij->i", v, v)
-                                              + prop[:, 2] * w * w))
+                                              + prop[:, 2] * w2))
             # ½ Δt F_n·v_{n+1/2} of the contact and element forces of the last step:
             # the half step by which the booked work runs ahead of the stored energy
             f = a["force"].to_numpy()
-            e["P_half"] = 0.5 * dt * float(np.sum(np.einsum("ij,ij->i", f, v)
-                                                  + a["torque"].to_numpy() * w))
+            tq = a["torque"].to_numpy()
+            tw = tq * w if w.ndim == 1 else np.einsum("ij,ij->i", tq, w)
+            e["P_half"] = 0.5 * dt * float(np.sum(np.einsum("ij,ij->i", f, v) + tw))
         if self._cont is not None:
             if strain:
                 e["strain"] = self._cont.strain_energy()

@@ -73,7 +73,8 @@ class Runner:
         return {"n": n, "cap": cap, "capw": capw, "walls": max(nwalls, 1), "laws": nlaws,
                 "law_width": _claw.table_width(self._law_set), "cells": ncell,
                 "cell_starts": ncell + 4096, "flags": FLAGS_SIZE, "simp": stepk.SIMP_SIZE,
-                "wall_width": stepk.WALL_WIDTH, "laws_set": self._law_set}
+                "wall_width": stepk.wall_width(self.dim), "laws_set": self._law_set,
+                "dim": self.dim}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
         return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
@@ -85,14 +86,14 @@ class Runner:
         r = np.concatenate(self._host["radius"])
         rho = np.concatenate(self._host["density"])
         shape = np.concatenate(self._host["shape"])
-        m, inertia = mass_properties(shape, rho, r)
+        m, inertia = mass_properties(shape, rho, r, self.dim)
         if self._cont is not None and self._cont.has_pcmm:
             pm = self._cont.masses
             inertia = np.where(np.isnan(pm), inertia, 0.5 * pm * r ** 2)
             m = np.where(np.isnan(pm), m, pm)
         n = len(r)
         om = (np.concatenate(self._host["omega"]) if len(self._host["omega"]) == len(
-            self._host["pos"]) else np.zeros(n))
+            self._host["pos"]) else np.zeros(n if self.dim == 2 else (n, 3)))
         s = self._new_rows(pos, vel, r, m, inertia, np.concatenate(self._host["law"]), shape,
                            np.concatenate(self._host["angle"]), om, self._cap, self._capw)
         s["flags"] = np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32)
@@ -103,8 +104,9 @@ class Runner:
         sizes = self._sizes(len(r), cap, capw, 1, 1, 1)
         work = np.zeros((len(r), 7))
         # the kinetic energy at the start, ½ m v² + ½ I ω²
+        w2 = omega * omega if np.ndim(omega) == 1 else np.einsum("ij,ij->i", omega, omega)
         work[:, 6] = 0.5 * (np.asarray(m) * np.einsum("ij,ij->i", vel, vel)
-                            + np.asarray(inertia) * omega * omega)
+                            + np.asarray(inertia) * w2)
         return schema.fresh_rows(len(r), sizes, {
             "ework": work, "omega": omega,
             "pos": pos, "vel": vel, "pos0": pos, "xref": pos, "shp": shape, "angle": angle,
@@ -148,7 +150,7 @@ class Runner:
         self._set_law_set(state)
         if new_particles is not None:
             pos, vel, r, rho, law, shape, ang, om = new_particles
-            m, inertia = mass_properties(shape, rho, r)
+            m, inertia = mass_properties(shape, rho, r, self.dim)
             n = len(r)
             add = self._new_rows(pos, vel, r, m, inertia, law, shape, ang, om,
                                  state["nbr"].shape[1], state["wid"].shape[1])
@@ -164,9 +166,11 @@ class Runner:
             if k in self._a:
                 self._fill(k, v)
         self._built = True
-        self._a["facc"].from_numpy(np.zeros((n, 3)))  # sums start from zero every step
+        # sums start from zero every step
+        self._a["facc"].from_numpy(np.zeros((n, self._a["facc"].n)))
         self._upload_laws()
-        self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.WALL_WIDTH), fresh=True)
+        self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.wall_width(self.dim)),
+                            fresh=True)
         self._fit_grid(force=True)
         self._apply_fixes(initial=True)
         self._apply_loads(initial=True)
@@ -196,8 +200,9 @@ class Runner:
         """Take the contact laws registered now (the kernels' ``laws``); the history
         arrays of ``state`` get the columns these laws need."""
         self._law_set = _claw.registered()
-        for k, width in (("hist", _claw.pair_history_width(self._law_set)),
-                         ("whist", _claw.wall_history_width(self._law_set))):
+        tdim = _claw.tangent_dim(self.dim)
+        for k, width in (("hist", _claw.pair_history_width(self._law_set, tdim)),
+                         ("whist", _claw.wall_history_width(self._law_set, tdim))):
             if k in state:
                 state[k] = _claw.remap_history(
                     state[k], width, tail=3 + len(_claw.PAIR_TAIL if k == "hist" else
@@ -212,13 +217,13 @@ class Runner:
     def _upload_params(self):
         p = np.zeros(stepk.SIMP_SIZE)
         p[stepk.P_DT] = self.dt
-        p[stepk.P_GX], p[stepk.P_GY] = self.gravity
+        p[[stepk.P_GX, stepk.P_GY, stepk.P_GZ][:self.dim]] = self.gravity
         p[stepk.P_ALPHA] = self.global_damping
         p[stepk.P_ALPHA_LOCAL] = self.local_damping
         p[stepk.P_SKIN] = self.skin
         p[stepk.P_NWALLS] = len(self._walls_host)
-        for (c0, cl), span in zip(((stepk.P_PX0, stepk.P_PLX), (stepk.P_PY0, stepk.P_PLY)),
-                                  self._periodic):
+        for (c0, cl), span in zip(((stepk.P_PX0, stepk.P_PLX), (stepk.P_PY0, stepk.P_PLY),
+                                   (stepk.P_PZ0, stepk.P_PLZ)), self._periodic):
             if span is not None:
                 p[c0], p[cl] = span[0], span[1] - span[0]
         self._a["simp"].from_numpy(p)
@@ -226,14 +231,15 @@ class Runner:
 
     def _wall_rows(self):
         if not self._built:
-            return np.array(self._walls_host, dtype=float).reshape(-1, stepk.WALL_WIDTH)
+            return np.array(self._walls_host, dtype=float).reshape(
+                -1, stepk.wall_width(self.dim))
         return self._a["wall"].to_numpy()[:len(self._walls_host)]
 
     def _set_wall_rows(self, rows, fresh=False):
         if not self._built:
             self._walls_host = list(rows)
             return
-        full = np.zeros((max(len(rows), 1), stepk.WALL_WIDTH))
+        full = np.zeros((max(len(rows), 1), stepk.wall_width(self.dim)))
         full[:len(rows)] = rows
         self._a["wall"].from_numpy(full)
         self._walls_host = list(rows)
@@ -241,7 +247,7 @@ class Runner:
 
     def _wall_loads(self):
         if not self._built:
-            return np.zeros((len(self._walls_host), 4))
+            return np.zeros((len(self._walls_host), 4 if self.dim == 2 else 7))
         return self._a["wforce"].to_numpy()[:len(self._walls_host)]
 
     def _cell_limit(self):
@@ -251,8 +257,8 @@ class Runner:
     def _grid_cells_for(self, pos, radius):
         h = 2.0 * float(radius.max()) + self.skin
         span = np.ptp(pos, axis=0) + 4 * h
-        nx, ny = (np.ceil(span / h).astype(np.int64) + 1)
-        return int(max(min(nx * ny, self._cell_limit()), 1))
+        counts = np.ceil(span / h).astype(np.int64) + 1
+        return int(max(min(np.prod(counts), self._cell_limit()), 1))
 
     def _fit_grid(self, force=False):
         """Fit the cell grid to the particles (host side, at checks).
@@ -265,9 +271,10 @@ class Runner:
         particles that touch still fall in neighbouring cells, so no contact is
         missed). Only where even the bulk is too wide do the cells grow."""
         a = self._a
-        neighbors.bounds(a["pos"], a["prop"], a["bounds"])
+        d = self.dim
+        neighbors.bounds(a["pos"], a["prop"], a["bounds"], d)
         b = a["bounds"].to_numpy()
-        lo, hi, rmax = b[:2], b[2:4], b[4]
+        lo, hi, rmax = b[:d], b[d:2 * d], b[2 * d]
         if not np.all(np.isfinite(b)) or hi[0] < lo[0]:
             return
         h = 2.0 * rmax + self.skin
@@ -279,16 +286,16 @@ class Runner:
         self._last_fit = self._steps
         bulk = getattr(self, "_grid_bulk", None)
         if not force:
-            cur_lo = gp[:2]
-            cur_hi = cur_lo + gp[2] * gn[:2]
+            cur_lo = gp[:d]
+            cur_hi = cur_lo + gp[d] * gn[:d]
             if bulk is not None:
                 # fitted to the bulk: refit once the whole box has changed by a cell
-                if gp[2] >= h and np.all(np.abs(b[:4] - bulk) <= h):
+                if gp[d] >= h and np.all(np.abs(b[:2 * d] - bulk) <= h):
                     return
             else:
                 inside = np.all(lo >= cur_lo) and np.all(hi <= cur_hi)
-                if (inside and gp[2] >= h
-                        and np.prod((hi - lo) / gp[2] + 1) > 0.25 * gn[0] * gn[1]):
+                if (inside and gp[d] >= h
+                        and np.prod((hi - lo) / gp[d] + 1) > 0.25 * np.prod(gn[:d])):
                     return
         margin = 2 * h
         limit = self._cell_limit()
@@ -297,29 +304,31 @@ class Runner:
             return np.floor((hi - lo + 2 * margin) / h).astype(np.int64) + 1
 
         self._grid_bulk = None
-        nx, ny = cells(lo, hi, h)
-        if nx * ny > limit and self._n >= 2:
+        counts = cells(lo, hi, h)
+        if np.prod(counts) > limit and self._n >= 2:
             pos = a["pos"].to_numpy()
             qlo, qhi = np.quantile(pos, [0.005, 0.995], axis=0, method="nearest")
             if np.prod(cells(qlo, qhi, h)) <= limit:
-                self._grid_bulk = b[:4].copy()
+                self._grid_bulk = b[:2 * d].copy()
                 lo, hi = qlo, qhi
-                nx, ny = cells(lo, hi, h)
-        while nx * ny > limit:
+                counts = cells(lo, hi, h)
+        while np.prod(counts) > limit:
             h *= 1.5
-            nx, ny = cells(lo, hi, h)
+            counts = cells(lo, hi, h)
         lo = lo - margin
-        self._set_grid(lo, (h, h), (nx, ny))
+        self._set_grid(lo, (h,) * d, counts)
 
     def _set_grid(self, lo, h, counts):
         a = self._a
-        nx, ny = (int(c) for c in counts)
+        counts = [int(c) for c in counts]
+        ncell = int(np.prod(counts))
+        rows = ncell // counts[0]
         ncap = a["cell_count"].shape[0]
-        if nx * ny > ncap or ny > 4096:
-            self._a["cell_count"] = ti.ndarray(ti.i32, (int(nx * ny),))
-            self._a["cell_start"] = ti.ndarray(ti.i32, (int(nx * ny) + max(int(ny), 4096),))
-        a["gridp"].from_numpy(np.array([lo[0], lo[1], h[0], h[1]], dtype=float))
-        a["gridn"].from_numpy(np.array([nx, ny, 0, 0], dtype=np.int32))
+        if ncell > ncap or rows > a["cell_start"].shape[0] - ncap:
+            self._a["cell_count"] = ti.ndarray(ti.i32, (ncell,))
+            self._a["cell_start"] = ti.ndarray(ti.i32, (ncell + max(rows, 4096),))
+        a["gridp"].from_numpy(np.array(list(lo) + list(h), dtype=float))
+        a["gridn"].from_numpy(np.array((counts + [0, 0])[:3] + [0], dtype=np.int32))
         a["flags"][F_REBUILD] = 1
         self._last_fit = self._steps
 
@@ -329,18 +338,20 @@ class Runner:
         along an open axis as :meth:`_fit_grid` (cells of side h, with a margin; clamped
         at the edges). Refits whenever the particles' box or size calls for it."""
         a = self._a
+        d = self.dim
         gp = a["gridp"].to_numpy()
         gn = a["gridn"].to_numpy()
-        origin, sides, counts = [0.0, 0.0], [h, h], [1, 1]
-        for k, span in enumerate(self._periodic):
+        origin, sides, counts = [0.0] * d, [h] * d, [1] * d
+        per = self._periodic[:d]
+        for k, span in enumerate(per):
             if span is not None:
                 length = span[1] - span[0]
                 c = int(math.floor(length / h))
                 if c < 3:
                     raise InputError(
-                        f"periodic: the {'xy'[k]} period {length:g} m must hold three cells of "
-                        f"the neighbour grid (2 × the largest radius + the skin = {h:g} m each), "
-                        f"i.e. be >= {3 * h:g} m")
+                        f"periodic: the {'xyz'[k]} period {length:g} m must hold three cells "
+                        f"of the neighbour grid (2 × the largest radius + the skin = {h:g} m "
+                        f"each), i.e. be >= {3 * h:g} m")
                 origin[k], sides[k], counts[k] = span[0], length / c, c
             else:
                 margin = 2 * h
@@ -348,17 +359,17 @@ class Runner:
                 origin[k], counts[k] = lo[k] - margin, c
         # keep the grid while the periodic cells are unchanged and the particles of an
         # open axis stay inside it, in cells not too large for them
-        same = all(gn[j] == counts[j] and abs(gp[2 + j] - sides[j]) <= 1e-12 * sides[j]
-                   for j in range(2) if self._periodic[j] is not None)
-        for k in range(2):
-            if self._periodic[k] is None:
-                same = same and lo[k] >= gp[k] and hi[k] <= gp[k] + gp[2 + k] * gn[k] and \
-                    gp[2 + k] >= h and (hi[k] - lo[k]) / gp[2 + k] + 1 > 0.25 * gn[k]
+        same = all(gn[j] == counts[j] and abs(gp[d + j] - sides[j]) <= 1e-12 * sides[j]
+                   for j in range(d) if per[j] is not None)
+        for k in range(d):
+            if per[k] is None:
+                same = same and lo[k] >= gp[k] and hi[k] <= gp[k] + gp[d + k] * gn[k] and \
+                    gp[d + k] >= h and (hi[k] - lo[k]) / gp[d + k] + 1 > 0.25 * gn[k]
         if same and not force:
             return
-        while counts[0] * counts[1] > self._cell_limit():
-            k = 0 if self._periodic[0] is None else 1
-            if self._periodic[k] is not None:
+        while np.prod(counts) > self._cell_limit():
+            k = next((j for j in range(d) if per[j] is None), None)
+            if k is None:
                 break
             sides[k] *= 1.5
             counts[k] = int(np.floor((hi[k] - lo[k] + 4 * h) / sides[k])) + 1
@@ -373,11 +384,15 @@ class Runner:
         t = self._time if t is None else t
         if initial:
             fix = np.zeros(self._n, np.int32)
-            self._vfix_host = np.zeros((self._n, 3))
+            self._vfix_host = np.zeros((self._n, 3 if self.dim == 2 else 6))
         vfix = self._vfix_host
         any_fn = False
+        # (bit, columns) of vx, vy, omega (2D) or vx, vy, vz, omega (3D)
+        cols = (((stepk.FIX_VX, 0), (stepk.FIX_VY, 1), (stepk.FIX_W, 2)) if self.dim == 2 else
+                ((stepk.FIX_VX, 0), (stepk.FIX_VY, 1), (stepk.FIX_VZ, 2),
+                 (stepk.FIX_W, slice(3, 6))))
         for ids, *vals in self._fixes:
-            for bit, col, v in zip((1, 2, 4), range(3), vals):
+            for (bit, col), v in zip(cols, vals):
                 if v is None:
                     continue
                 if initial:
@@ -398,7 +413,7 @@ class Runner:
         if not self._loads or not self._n:
             return
         t = self._time if t is None else t
-        ext = np.zeros((self._n, 3))
+        ext = np.zeros((self._n, 3 if self.dim == 2 else 6))
         any_fn = False
         for ids, *vals in self._loads:
             for col, v in enumerate(vals):
@@ -414,11 +429,11 @@ class Runner:
 
     # ------------------------------------------------------------------ stepping
     def _step_args(self):
-        # the arrays by name; _one_step appends the last four (detail, continuum, laws,
-        # shapes)
+        # the arrays by name; _one_step appends the last five (detail, continuum, laws,
+        # shapes, dim)
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
                            loads=bool(self._loads_on), detail=False, continuum=False,
-                           laws=self._law_set, shapes=False)[:-4]
+                           laws=self._law_set, shapes=False, dim=self.dim)[:-5]
 
     def _xforce(self):
         if self._cont is not None:
@@ -451,7 +466,7 @@ class Runner:
 
     def _rebuild_args(self):
         return schema.bind(neighbors.rebuild, self._a, sorted_ids=self._a["sorted"],
-                           nwalls=len(self._walls_host), skin=float(self.skin))
+                           nwalls=len(self._walls_host), skin=float(self.skin), dim=self.dim)
 
     def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
         """One time step: the stages in the order the data flows (Feng et al.'s seven
@@ -486,7 +501,7 @@ class Runner:
             cont.viscous_boundaries(self)
         if self._n:
             stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set,
-                       self._has_shapes)
+                       self._has_shapes, self.dim)
         if cont is not None:
             cont.integrate(self)
         self._time += dt
@@ -519,13 +534,15 @@ class Runner:
             m.truncate(self._steps)
         if self._output is not None:
             self._output.truncate(self._steps)
+        # the records of the steps redone are due again
+        self._plan_events()
 
     def _status(self):
         a = self._a
         if self._n == 0:
             return np.array([0, 0, 0, 0, 0, 0, 0, 0], np.int32)
         stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["flags"],
-                              float(self._dt_run))
+                              float(self._dt_run), self.dim)
         return a["flags"].to_numpy()
 
     def _warn_dense_packing(self, dt):

@@ -33,7 +33,7 @@ from . import mesh as _mesh
 from . import pack as _pack
 from . import step as stepk
 from .errors import InputError
-from .handles import (Block, ParticleGroup, Wall, _View, _as_xy, _fix_value, _in_box,
+from .handles import (Block, Mesh, ParticleGroup, Wall, _View, _as_xy, _fix_value, _in_box,
                       _vector2)
 from .results import Results
 from .neighbors import F_BUILDS, F_NONCONV
@@ -76,6 +76,29 @@ def _warn_overlaps(old, old_r, new, new_r):
                       RuntimeWarning, stacklevel=3)
 
 
+def _quaternions(name, q, n):
+    """(n, 4) unit quaternions (w, x, y, z) from None (the identity), one (4,) or (n, 4);
+    refused naming ``name`` unless finite and of unit norm (to 1e-6)."""
+    if q is None:
+        return np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+    try:
+        a = np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be unit quaternions (w, x, y, z), got {q!r}") from None
+    if a.shape == (4,):
+        a = np.tile(a, (n, 1))
+    if a.shape != (n, 4):
+        raise InputError(f"{name} must have shape ({n}, 4) or (4,): unit quaternions "
+                         f"(w, x, y, z), got shape {a.shape}")
+    norm = np.linalg.norm(a, axis=1)
+    bad = ~(np.isfinite(a).all(axis=1) & (np.abs(norm - 1.0) <= 1e-6))
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(f"{name} must be unit quaternions: row {k} is {a[k].tolist()} "
+                         f"(norm {norm[k]:.6g})")
+    return a / norm[:, None]
+
+
 def _refuse_coincident(old, new):
     """Refuse new particles whose centre coincides with another's (a contact of no
     direction: the run would fail at its first step)."""
@@ -91,11 +114,11 @@ def _refuse_coincident(old, new):
 
 
 class Simulation(Runner, Results):
-    """A 2D DEM simulation (plane, unit thickness, SI units).
+    """A DEM simulation in 2D (plane, unit thickness) or 3D (``dim=3``), SI units.
 
     Parameters
     ----------
-    gravity : (2,) m/s²
+    gravity : (2,) or, in 3D, (3,) m/s²; None: 9.81 m/s² along −y (2D) or −z (3D)
     dt : float or None
         Time step; None picks ``dt_fraction`` × the critical step 2·sqrt(m/k).
     dt_fraction : float in (0, 1]
@@ -107,12 +130,21 @@ class Simulation(Runner, Results):
     check_interval : steps between host checks (status, monitors, output)
     progress : None (a bar on a terminal for runs over 2 s), True or False
     threads : CPU threads (process-wide; None: Taichi's default or ``$TDEM_THREADS``)
+    dim : 2 or 3. In 3D the particles are spheres (positions, velocities and spins
+        are 3-vectors, orientations unit quaternions) and the walls triangle meshes
+        (:meth:`add_mesh`); PCMM bodies, blocks, segment walls, superellipses and
+        rolling resistance are 2D.
     """
 
-    def __init__(self, gravity=(0.0, -9.81), dt=None, dt_fraction=0.2, arch=None,
+    def __init__(self, gravity=None, dt=None, dt_fraction=0.2, arch=None,
                  precision="f64", local_damping=0.0, global_damping=0.0, skin=None,
-                 check_interval=100, progress=None, threads=None):
-        g = _vector2("gravity", gravity)
+                 check_interval=100, progress=None, threads=None, dim=2):
+        if dim not in (2, 3) or isinstance(dim, bool):
+            raise InputError(f"dim must be 2 or 3, got {dim!r}")
+        self.dim = int(dim)
+        if gravity is None:
+            gravity = (0.0, -9.81) if dim == 2 else (0.0, 0.0, -9.81)
+        g = _vector2("gravity", gravity, self.dim)
         if precision not in ("f64", "f32"):
             raise InputError(f"precision must be 'f64' or 'f32', got {precision!r}")
         dt_fraction = in_range("dt_fraction", dt_fraction, 0.0, 1.0, lo_open=True)
@@ -155,7 +187,8 @@ class Simulation(Runner, Results):
         self._nonreflect = []      # ("p" | "v", ids, coef rows) of viscous boundaries
         self._lights = []          # (ids, lighting times) of JWL particles, before the build
         self._walls_host = []      # rows of the wall table
-        self._periodic = [None, None]   # (start, end) of the periodic x and y axes
+        self._periodic = [None] * self.dim   # (start, end) of the periodic x, y (z) axes
+        self._meshes = []          # 3D: (first triangle row, number of rows) of each mesh
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
         self._built = False
@@ -194,8 +227,9 @@ class Simulation(Runner, Results):
         self._laws.append(law)
         return len(self._laws) - 1
 
-    def periodic(self, x=None, y=None):
-        """Make the x and/or y axis periodic over [x0, x1) (and [y0, y1)): particles that
+    def periodic(self, x=None, y=None, z=None):
+        """Make the x and/or y (and in 3D z) axis periodic over [x0, x1) (and [y0, y1),
+        [z0, z1)): particles that
         leave on one side come back on the other, the neighbour search and the contacts
         see across the boundary (between images), walls and output are unaffected.
         ``None`` leaves an axis as it is; ``False`` makes it open again. The period
@@ -203,7 +237,9 @@ class Simulation(Runner, Results):
         each), checked when a run starts. PCMM particles and blocks cannot be periodic.
         """
         new = list(self._periodic)
-        for k, (name, v) in enumerate((("x", x), ("y", y))):
+        if z is not None and self.dim == 2:
+            raise InputError(f"z: a 2D simulation has no z axis (got z={z!r})")
+        for k, (name, v) in enumerate((("x", x), ("y", y), ("z", z))[:self.dim]):
             if v is None:
                 continue
             if v is False:
@@ -230,7 +266,7 @@ class Simulation(Runner, Results):
 
     def add_particles(self, positions, radius=None, density=2500.0, contact=None,
                       material=None, tolerance=0.0, velocity=None, shape=None, angle=None,
-                      omega=None):
+                      omega=None, orientation=None):
         """Add discs (``radius``) or shaped particles (``shape``, e.g.
         :class:`tdem.Superellipse`, turned by ``angle``: degrees, counter-clockwise, a
         number or one per particle; default 0); returns a :class:`ParticleGroup`
@@ -248,8 +284,20 @@ class Simulation(Runner, Results):
         between particles that touch but share no element (and against walls and
         other particles); by default a linear law with k_n = k_s = E (N/m per metre
         of thickness) and friction tan φ (MohrCoulomb) or 0.5.
+
+        In 3D (``dim=3``): spheres of ``radius`` at (N, 3) ``positions``; ``velocity``
+        and ``omega`` (N, 3) or (3,); ``orientation`` (N, 4) or (4,) unit quaternions
+        (w, x, y, z), default (1, 0, 0, 0).
         """
         slot = -1
+        if self.dim == 3:
+            self._refuse_2d_only(shape=shape, material=material, angle=angle)
+            if contact is not None and getattr(contact, "rolling", None) is not None:
+                raise InputError(f"contact: rolling resistance is 2D only for now; 3D "
+                                 f"spheres take a law without rolling= (got {contact!r})")
+        elif orientation is not None:
+            raise InputError(f"orientation: a 2D particle's orientation is its angle= "
+                             f"(got orientation={orientation!r})")
         if shape is not None:
             if not isinstance(shape, Superellipse):
                 raise InputError(f"shape must be a shape such as tdem.Superellipse(a, b, n), got "
@@ -291,7 +339,7 @@ class Simulation(Runner, Results):
         elif self._built and self._cont is not None:
             raise InputError("positions: particles cannot be added after the first run of a "
                              "model with PCMM particles or blocks")
-        pos = _as_xy("positions", positions)
+        pos = _as_xy("positions", positions, dim=self.dim)
         n = len(pos)
         if n == 0:
             raise InputError("positions must hold at least one particle, got none")
@@ -306,7 +354,7 @@ class Simulation(Runner, Results):
         else:
             r = _per_particle("radius", radius, n)
             shp = np.zeros((n, 4))
-            ang = np.zeros(n)
+            ang = np.zeros(n) if self.dim == 2 else _quaternions("orientation", orientation, n)
         bad = ~(np.isfinite(r) & (r > 0))
         if bad.any():
             k = int(np.argmax(bad))
@@ -318,14 +366,18 @@ class Simulation(Runner, Results):
             raise InputError(f"density must be positive: particle {k} has density {float(rho[k])!r}")
         if contact is None:
             raise InputError("contact must be given: a law such as tdem.LinearContact(kn=...)")
-        vel = np.zeros((n, 2)) if velocity is None else _as_xy("velocity", velocity, n)
-        om = _per_particle("omega", 0.0 if omega is None else omega, n)
+        vel = np.zeros((n, self.dim)) if velocity is None else _as_xy("velocity", velocity, n,
+                                                                        dim=self.dim)
+        if self.dim == 3:
+            om = np.zeros((n, 3)) if omega is None else _as_xy("omega", omega, n, dim=3)
+        else:
+            om = _per_particle("omega", 0.0 if omega is None else omega, n)
         if not np.isfinite(om).all():
             k = int(np.argmax(~np.isfinite(om)))
             raise InputError(f"omega must be finite: particle {k} has omega {float(om[k])!r}")
         state = self._download() if self._built else None
         old = state["pos"] if state is not None else (
-            np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, 2)))
+            np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, self.dim)))
         _refuse_coincident(old, pos)
         if material is None:
             # (a shape's inscribed circle: a warning means a real overlap)
@@ -379,6 +431,8 @@ class Simulation(Runner, Results):
         rigid body (3 degrees of freedom: its mass, centre and moment of inertia from
         the lumped masses; no stress), free, or driven by fixing all its nodes.
         ``velocity``: initial velocity of every node. Returns a :class:`Block`."""
+        if self.dim == 3:
+            self._refuse_2d_only(material=material)
         if rigid not in (True, False):
             raise InputError(f"rigid must be True or False, got {rigid!r}")
         if not isinstance(material, Material):
@@ -412,6 +466,8 @@ class Simulation(Runner, Results):
         both ways between the two blocks' boundaries. Must be called before the
         first run."""
         from coupling.point_edge import PointEdge
+        if self.dim == 3:
+            self._refuse_2d_only(law=law)
         if not isinstance(law, PointEdge):
             raise InputError(f"law must be a tdem.PointEdge(...), got {law!r}")
         if not isinstance(b, Block) or b._sim is not self:
@@ -621,6 +677,10 @@ class Simulation(Runner, Results):
                  center=None):
         """Add a rigid segment from p0 to p1; it moves with ``velocity`` and rotates at
         ``angular_velocity`` (rad/s) about ``center`` (default: its midpoint)."""
+        if self.dim == 3:
+            raise InputError("add_wall adds a 2D segment; a 3D simulation takes triangle "
+                             "meshes: sim.add_mesh(vertices, triangles, contact=...) (planes, "
+                             "boxes and cylinders: tdem.surfaces)")
         a, b = _vector2("p0", p0), _vector2("p1", p1)
         if np.allclose(a, b):
             raise InputError(f"p1 must differ from p0, got p0={a.tolist()} p1={b.tolist()}")
@@ -643,28 +703,119 @@ class Simulation(Runner, Results):
             self._walls_host.append(row)
         return Wall(self, len(self._walls_host) - 1)
 
+    def add_mesh(self, vertices, triangles=None, contact=None, velocity=(0.0, 0.0, 0.0),
+                 angular_velocity=(0.0, 0.0, 0.0), center=None):
+        """3D: add a rigid triangle-mesh wall; returns a :class:`tdem.handles.Mesh`.
+
+        ``vertices`` (V, 3) and ``triangles`` (T, 3) vertex indices, or ``vertices`` the
+        path of a file meshio reads (STL, OBJ, …) and ``triangles`` None. The mesh
+        translates at ``velocity`` and turns at ``angular_velocity`` (rad/s, a
+        3-vector) about ``center`` (default: the vertices' centroid). Spheres meet its
+        faces, edges and vertices (:mod:`physics.geometry.sphere_triangle`)."""
+        if self.dim != 3:
+            raise InputError("add_mesh is 3D: use tdem.Simulation(dim=3); a 2D simulation "
+                             "takes segment walls (add_wall)")
+        if isinstance(vertices, (str, bytes)) or hasattr(vertices, "__fspath__"):
+            if triangles is not None:
+                raise InputError("triangles: give a file or arrays, not both (got a file and "
+                                 f"triangles of type {type(triangles).__name__})")
+            from .surfaces import read
+            vertices, triangles = read(vertices)
+        try:
+            v = np.asarray(vertices, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"vertices must be a (V, 3) array of numbers, got "
+                             f"{vertices!r}") from None
+        if v.ndim != 2 or v.shape[1] != 3 or len(v) < 3 or not np.isfinite(v).all():
+            raise InputError(f"vertices must be a finite (V, 3) array with V >= 3, got shape "
+                             f"{v.shape}")
+        try:
+            t = np.asarray(triangles)
+        except (TypeError, ValueError):
+            t = np.zeros((0,))
+        if t.ndim != 2 or t.shape[1] != 3 or len(t) == 0 or t.dtype.kind not in "iu":
+            raise InputError(f"triangles must be a (T, 3) array of vertex indices, got "
+                             f"{triangles!r:.80}")
+        if t.min() < 0 or t.max() >= len(v):
+            raise InputError(f"triangles: vertex indices must lie in [0, {len(v) - 1}], got "
+                             f"{int(t.min())}..{int(t.max())}")
+        a, b, c = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
+        area2 = np.linalg.norm(np.cross(b - a, c - a), axis=1)
+        scale = float(np.ptp(v, axis=0).max())
+        bad = ~(area2 > 1e-12 * scale * scale)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise InputError(f"triangles: triangle {k} {t[k].tolist()} has no area (its "
+                             f"corners are in line)")
+        if contact is None:
+            raise InputError("contact must be given: a law such as tdem.HertzMindlin(...)")
+        vel = _vector2("velocity", velocity, 3)
+        om = _vector2("angular_velocity", angular_velocity, 3)
+        cen = v.mean(axis=0) if center is None else _vector2("center", center, 3)
+        law = self._law_id(contact)
+        rows = np.zeros((len(t), stepk.TRI_WIDTH))
+        rows[:, stepk.T_AX:stepk.T_AX + 3] = a
+        rows[:, stepk.T_BX:stepk.T_BX + 3] = b
+        rows[:, stepk.T_CX:stepk.T_CX + 3] = c
+        rows[:, stepk.T_VX:stepk.T_VX + 3] = vel
+        rows[:, stepk.T_WX:stepk.T_WX + 3] = om
+        rows[:, stepk.T_OX:stepk.T_OX + 3] = cen
+        rows[:, stepk.T_LAW] = law
+        rows[:, stepk.T_MESH] = len(self._meshes)
+        state = self._download() if self._built else None
+        self._meshes.append((len(self._walls_host), len(t)))
+        self._walls_host.extend(rows)
+        if state is not None:
+            self._rebuild_from(state)
+        return Mesh(self, len(self._meshes) - 1)
+
+    @property
+    def meshes(self):
+        """The mesh walls (3D), in the order added."""
+        return [Mesh(self, k) for k in range(len(self._meshes))]
+
+    def _refuse_2d_only(self, **given):
+        """In 3D, refuse the arguments of 2D-only features, naming the first given."""
+        for name, v in given.items():
+            if v is not None:
+                raise InputError(f"{name}: a 2D feature (PCMM bodies, blocks, superellipses, "
+                                 f"segment walls and rolling resistance are 2D); a 3D "
+                                 f"simulation takes spheres and mesh walls (got {name}={v!r})")
+
     @property
     def walls(self):
-        return [Wall(self, k) for k in range(len(self._walls_host))]
+        return [Wall(self, k) for k in range(len(self._walls_host))] if self.dim == 2 else []
 
-    def fix_particles(self, ids, vx=0.0, vy=None, omega=None):
+    def fix_particles(self, ids, vx=0.0, vy=None, omega=None, vz=None):
         """Prescribe velocity components of particles ``ids``.
 
-        Each of vx, vy, omega is None (free), a float, an array (one per id) or a
-        function of time returning either.
+        Each of vx, vy, omega (and vz in 3D) is None (free), a float, an array (one per
+        id) or a function of time returning either; in 3D omega is None or a constant
+        3-vector.
         """
         ids = indices("ids", ids, self._n)
-        vals = [_fix_value(name, v, ids) for name, v in (("vx", vx), ("vy", vy), ("omega", omega))]
+        if self.dim == 2:
+            if vz is not None:
+                raise InputError(f"vz: a 2D simulation has no z axis (got vz={vz!r})")
+            vals = [_fix_value(name, v, ids)
+                    for name, v in (("vx", vx), ("vy", vy), ("omega", omega))]
+        else:
+            vals = [_fix_value(name, v, ids) for name, v in (("vx", vx), ("vy", vy), ("vz", vz))]
+            vals.append(None if omega is None else _vector2("omega", omega, 3))
         self._fixes.append((ids, *vals))
         if self._built:
             self._apply_fixes(initial=True)
 
-    def apply_force(self, ids, fx=None, fy=None, moment=None):
+    def apply_force(self, ids, fx=None, fy=None, moment=None, fz=None):
         """Apply forces (N per metre of thickness) and moments (N·m/m) to particles
         ``ids``. Each of fx, fy, moment is None, a float, an array (one per id) or a
         function of time returning either; loads add up over calls. Blocks have
         :meth:`Block.apply_force` and :meth:`Block.apply_pressure`."""
         ids = indices("ids", ids, self._n)
+        if self.dim == 3:
+            raise InputError("apply_force: applied loads are 2D for now")
+        if fz is not None:
+            raise InputError(f"fz: a 2D simulation has no z axis (got fz={fz!r})")
         vals = [_fix_value(name, v, ids)
                 for name, v in (("fx", fx), ("fy", fy), ("moment", moment))]
         self._loads.append((ids, *vals))
@@ -774,7 +925,8 @@ class Simulation(Runner, Results):
         if self._built:
             return self._a["prop"].to_numpy()[:, 2]
         return mass_properties(np.concatenate(self._host["shape"]),
-                               np.concatenate(self._host["density"]), self._radii())[1]
+                               np.concatenate(self._host["density"]), self._radii(),
+                               self.dim)[1]
 
     def _masses(self):
         """(radius, mass, law group) of every particle, from the device once built."""
@@ -782,7 +934,7 @@ class Simulation(Runner, Results):
         if self._built:
             return r, self._a["prop"].to_numpy()[:, 1], self._a["plaw"].to_numpy()
         m = mass_properties(np.concatenate(self._host["shape"]),
-                            np.concatenate(self._host["density"]), r)[0]
+                            np.concatenate(self._host["density"]), r, self.dim)[0]
         return r, m, np.concatenate(self._host["law"])
 
     def _laws_met(self, plaw):

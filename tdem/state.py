@@ -53,39 +53,40 @@ PROP_WIDTH = 3
 # cell_starts; and fixed numbers
 ENGINE = (
     # particles: kinematics, properties, prescribed motion
-    Array("pos", "particle", 2, "f", "dynamic", doc="position x_n (m)"),
-    Array("vel", "particle", 2, "f", "dynamic", doc="velocity v_{n-1/2} (m/s)"),
-    Array("omega", "particle", 0, "f", "dynamic", doc="spin (rad/s)"),
-    Array("angle", "particle", 0, "f", "dynamic", doc="angle θ (rad, counter-clockwise)"),
+    Array("pos", "particle", "D", "f", "dynamic", doc="position x_n (m)"),
+    Array("vel", "particle", "D", "f", "dynamic", doc="velocity v_{n-1/2} (m/s)"),
+    Array("omega", "particle", "S", "f", "dynamic", doc="spin (rad/s; a 3-vector in 3D)"),
+    Array("angle", "particle", "Q", "f", "dynamic",
+          doc="angle θ (rad, counter-clockwise); in 3D the unit quaternion (w, x, y, z)"),
     Array("shp", "particle", 4, "f", "setup",
           doc="shape (a, b, n, area) of a superellipse (m, m, -, m²); n = 0 for a disc"),
     Array("prop", "particle", PROP_WIDTH, "f", "setup",
           doc="radius (m), mass (kg/m), inertia (kg m²/m): columns PROP_*"),
     Array("plaw", "particle", "i", "i32", "setup", doc="law group of the particle"),
     Array("fix", "particle", "i", "i32", "setup", doc="prescribed-velocity bits (step.FIX_*)"),
-    Array("vfix", "particle", 3, "f", "setup", doc="prescribed vx, vy, omega"),
-    Array("force", "particle", 2, "f", "dynamic", doc="contact + element force (output)"),
-    Array("torque", "particle", 0, "f", "dynamic", doc="moment (output)"),
-    Array("xref", "particle", 2, "f", "dynamic", doc="position at the last list build"),
-    Array("pos0", "particle", 2, "f", "dynamic",
+    Array("vfix", "particle", "DS", "f", "setup", doc="prescribed velocity, spin"),
+    Array("force", "particle", "D", "f", "dynamic", doc="contact + element force (output)"),
+    Array("torque", "particle", "S", "f", "dynamic", doc="moment (output)"),
+    Array("xref", "particle", "D", "f", "dynamic", doc="position at the last list build"),
+    Array("pos0", "particle", "D", "f", "dynamic",
           doc="position at the start (displacement; shifted with a periodic wrap)"),
-    Array("facc", "particle", 3, "f", "scratch", doc="force and moment sums of a step"),
+    Array("facc", "particle", "DS", "f", "scratch", doc="force and moment sums of a step"),
     Array("eacc", "particle", 2, "f", "dynamic", doc="dissipated energy, boundary work (J/m)"),
     Array("estate", "particle", 2, "f", "dynamic", doc="kinetic, gravitational energy at t_n"),
     Array("ework", "particle", 7, "f", "dynamic",
           doc="work done since the start by the contacts, the continuum (elements, "
               "point-edge contacts, viscous boundaries), gravity, damping, prescribed "
               "velocities, applied forces (J/m); kinetic energy at the start (J/m)"),
-    Array("fext", "particle", 3, "f", "setup",
-          doc="applied force fx, fy (N/m) and moment (N m/m), sim.apply_force"),
+    Array("fext", "particle", "DS", "f", "setup",
+          doc="applied force (N/m) and moment (N m/m), sim.apply_force"),
     Array("ncnt", "particle", "i", "i32", "dynamic", doc="length of the half list"),
     Array("rcnt", "particle", "i", "i32", "dynamic", doc="length of the reverse list"),
     Array("ncnt_old", "particle", "i", "i32", "scratch", doc="half list before a rebuild"),
     # pair slots (half list, owner = lower index)
     Array("nbr", "slot", "i", "i32", "dynamic", fill=-1, doc="partner index"),
     Array("hist", "slot", "H", "f", "dynamic", doc="contact history (law, rolling, u0)"),
-    Array("cn", "slot", 2, "f", "dynamic", doc="contact normal (output)"),
-    Array("cf", "slot", 3, "f", "dynamic", doc="force on the owner, moment on the partner"),
+    Array("cn", "slot", "D", "f", "dynamic", doc="contact normal (output)"),
+    Array("cf", "slot", "DS", "f", "dynamic", doc="force on the owner, moment on the partner"),
     Array("cs", "slot", 3, "f", "dynamic", doc="F_n, F_s, overlap (output)"),
     Array("rev", "slot", "i", "i32", "dynamic", doc="reverse list: owner << bits | slot"),
     Array("nbr_old", "slot", "i", "i32", "scratch", fill=-1, doc="half list before a rebuild"),
@@ -94,14 +95,16 @@ ENGINE = (
     # wall slots
     Array("wid", "wall_slot", "i", "i32", "dynamic", fill=-1, doc="candidate wall index"),
     Array("whist", "wall_slot", "HW", "f", "dynamic", doc="wall contact history"),
-    Array("wcn", "wall_slot", 2, "f", "dynamic", doc="wall contact normal (output)"),
-    Array("wcf", "wall_slot", 4, "f", "dynamic", doc="wall contact force, moment (output)"),
+    Array("wcn", "wall_slot", "D", "f", "dynamic", doc="wall contact normal (output)"),
+    Array("wcf", "wall_slot", {2: 4, 3: 6}, "f", "dynamic",
+          doc="wall contact force, moment (output)"),
     Array("wcs", "wall_slot", 3, "f", "dynamic", doc="F_n, F_s, overlap (output)"),
     Array("wid_old", "wall_slot", "i", "i32", "scratch", fill=-1, doc="before a rebuild"),
     Array("whist_old", "wall_slot", "HW", "f", "scratch", doc="before a rebuild"),
     # walls and tables
     Array("wall", "table", ("walls", "wall_width"), "f64", "dynamic", doc="wall rows (step.W_*)"),
-    Array("wforce", "wall", 4, "f64", "dynamic", doc="fx, fy, moment, contacts received"),
+    Array("wforce", "wall", {2: 4, 3: 7}, "f64", "dynamic",
+          doc="force, moment about the wall's centre, contacts received"),
     Array("lawp", "table", ("laws", "law_width"), "f64", "scratch", doc="law parameters"),
     Array("lawpair", "table", ("laws", "laws"), "i32", "scratch", doc="law of a pair of groups"),
     Array("flags", "table", ("flags",), "i32", "dynamic", doc="status word (neighbors.F_*)"),
@@ -111,9 +114,11 @@ ENGINE = (
     Array("cell_start", "table", ("cell_starts",), "i32", "scratch", doc="prefix sums"),
     Array("sorted", "particle", "i", "i32", "scratch", doc="particles by cell"),
     Array("pcell", "particle", "i", "i32", "scratch", doc="cell of a particle"),
-    Array("gridp", "table", (4,), "f64", "setup", doc="grid origin, cell size"),
-    Array("gridn", "table", (4,), "i32", "setup", doc="grid cells per axis"),
-    Array("bounds", "table", (5,), "f64", "scratch", doc="bounding box of the particles"),
+    Array("gridp", "table", ("dim2",), "f64", "setup", doc="grid origin, cell sizes"),
+    Array("gridn", "table", (4,), "i32", "setup",
+          doc="grid cells per axis (nz = 0 in 2D), particles"),
+    Array("bounds", "table", ("dim2p1",), "f64", "scratch",
+          doc="bounding box of the particles (lower, upper corner), largest radius"),
 )
 BY_NAME = {a.name: a for a in ENGINE}
 
@@ -128,21 +133,33 @@ def saved():
     return tuple(a.name for a in ENGINE if a.role != "scratch")
 
 
-def _comps(a, laws):
-    if a.comps == "H":
-        return contact_law.pair_history_width(laws)
-    if a.comps == "HW":
-        return contact_law.wall_history_width(laws)
-    return a.comps
+def _comps(a, sizes):
+    """Components of array ``a``: a number, or by the dimension (``sizes["dim"]``,
+    2 unless given): "D" a position vector, "S" a spin (a scalar in 2D, a 3-vector
+    in 3D), "DS" both, "Q" an orientation (the angle in 2D, a unit quaternion in
+    3D), a dict {dim: k}, "H" / "HW" the history vectors."""
+    dim = sizes.get("dim", 2)
+    c = a.comps
+    if c in ("H", "HW"):
+        tdim = contact_law.tangent_dim(dim)
+        f = contact_law.pair_history_width if c == "H" else contact_law.wall_history_width
+        return f(sizes["laws_set"], tdim)
+    if isinstance(c, dict):
+        return c[dim]
+    return {"D": dim, "S": 0 if dim == 2 else 3, "DS": 3 if dim == 2 else 6,
+            "Q": 0 if dim == 2 else 4}.get(c, c)
 
 
 def shape(a, sizes):
     """Shape (and vector width, or None) of array ``a`` for ``sizes`` (a dict)."""
     if a.owner == "table":
-        return tuple(sizes[s] if isinstance(s, str) else s for s in a.comps), None
+        dim = sizes.get("dim", 2)
+        derived = {"dim2": 2 * dim, "dim2p1": 2 * dim + 1}
+        return tuple(derived[s] if s in derived else sizes[s] if isinstance(s, str) else s
+                     for s in a.comps), None
     lead = {"particle": ("n",), "slot": ("n", "cap"), "wall_slot": ("n", "capw"),
             "wall": ("walls",)}[a.owner]
-    comps = _comps(a, sizes["laws_set"])
+    comps = _comps(a, sizes)
     return tuple(sizes[s] for s in lead), (None if comps in (0, "i") else comps)
 
 

@@ -14,19 +14,21 @@ Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
 """
 import taichi as ti
 
-from physics.contact_law import (TANGENT_2D, history_width, law_energy, law_force,
-                                 law_stiffness, zero_history)
-from physics.geometry import disc_disc, disc_segment
+from physics.contact_law import (history_width, law_energy, law_force, law_stiffness,
+                                 rotate_tangential, tangent_dim, zero_history)
+from physics.geometry import disc_disc, disc_segment, sphere_triangle
 from physics.geometry import superellipse as se
-from physics.geometry.frame import tangent_part, tangent_vector
+from physics.geometry.frame import (moment, pack, spin_cross, spin_dot, spin_zero,
+                                    tangent_part, tangent_vector, unpack, vec_zero)
 from physics.rolling import rolling_couple, rolling_energy
 
 from .finite import any_non_finite, non_finite
 from .integrate import damped_leapfrog
 from .launch import cached
 from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY,  # noqa: F401
-                        P_NWALLS, P_PLX, P_PLY, P_PX0, P_PY0, P_SKIN, SIMP_SIZE, image,
-                        slot_bits)
+                        P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0, P_PZ0, P_SKIN,
+                        SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH, T_OX, T_VX, T_WX,
+                        TRI_WIDTH, gravity, image, periodic_axes, slot_bits)
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
@@ -37,8 +39,16 @@ from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 (W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW, W_INVLL, W_DISP,
  W_SERVO_K, W_SERVO_F, W_SERVO_DX, W_SERVO_DY, W_SERVO_ALPHA, W_SERVO_VMAX) = range(18)
 WALL_WIDTH = 18
-# fixed-velocity bits
-FIX_VX, FIX_VY, FIX_W = 1, 2, 4
+# 3D: the wall table holds the triangles of the mesh walls (columns T_*, tdem.neighbors)
+
+
+def wall_width(dim):
+    """Columns of a row of the wall table: a segment (2D) or a mesh triangle (3D)."""
+    return WALL_WIDTH if dim == 2 else TRI_WIDTH
+
+
+# fixed-velocity bits (FIX_W: every spin component; FIX_VZ: 3D)
+FIX_VX, FIX_VY, FIX_W, FIX_VZ = 1, 2, 4, 8
 
 
 @ti.func
@@ -57,7 +67,8 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     output, stress and energy). The history vector holds the law's columns, the
     rolling couple, rotation and broken flag (from column R) and the overlap offset
     u0 (the last column)."""
-    R = ti.static(history_width(laws))
+    dim = ti.static(xi.n)
+    R = ti.static(history_width(laws, tangent_dim(dim)))
     U0 = ti.static(R + 3)
     j = nbr[i, k]
     pj = prop[j]
@@ -70,9 +81,9 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     h = hist[i, k]
     u0 = ti.min(h[U0], ti.max(u_geo, 0.0))
     u = u_geo - u0
-    f = ti.Vector([0.0, 0.0])
-    m_on_i = 0.0
-    m_on_j = 0.0
+    f = vec_zero(dim)
+    m_on_i = spin_zero(dim)
+    m_on_j = spin_zero(dim)
     diss = 0.0
     if u > 0.0:
         wj = omega[j]
@@ -81,20 +92,30 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         L = lawpair[li, plaw[j]]
         mj = pj[PROP_MASS]
         reff = ri * rj / (ri + rj)
+        if ti.static(dim == 3):
+            h = rotate_tangential(laws, lawp, L, h, n)
         fn_el, fn, ft, kn, cnd, d1, h = law_force(
             laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h)
-        fs_tot = ft[0]
-        m, m_tot, th, brk, d2 = rolling_couple(
-            lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
-        f = -fn * n + tangent_vector(ft, n)
-        m_on_i = ai * fs_tot + m_tot
-        m_on_j = aj * fs_tot - m_tot
-        h[R] = m
-        h[R + 1] = th
-        h[R + 2] = brk
+        fs_tot = 0.0
+        if ti.static(dim == 2):
+            fs_tot = ft[0]
+            m, m_tot, th, brk, d2 = rolling_couple(
+                lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
+            f = -fn * n + tangent_vector(ft, n)
+            m_on_i = ai * fs_tot + m_tot
+            m_on_j = aj * fs_tot - m_tot
+            h[R] = m
+            h[R + 1] = th
+            h[R + 2] = brk
+            diss = d1 + d2
+        else:
+            fs_tot = ft.norm()
+            f = -fn * n + ft
+            m_on_i = moment(ai * n, f)
+            m_on_j = moment(aj * n, f)
+            diss = d1
         h[U0] = u0
         hist[i, k] = h
-        diss = d1 + d2
         if ti.static(detail):
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, fs_tot, u])
@@ -202,6 +223,131 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
 
 
 @ti.func
+def _tri(wall: ti.template(), w, c: ti.template()):
+    return ti.Vector([wall[w, c], wall[w, c + 1], wall[w, c + 2]])
+
+
+@ti.func
+def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
+                  prop: ti.template(), wall: ti.template(), wforce: ti.template(),
+                  lawp: ti.template(), wid: ti.template(), whist: ti.template(),
+                  wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
+                  laws: ti.template()):
+    """3D: contacts of sphere i with its candidate mesh triangles (wall slots), by the
+    nearest point of each triangle (:mod:`physics.geometry.sphere_triangle`). Of the
+    triangles of one mesh that it touches, face contacts are kept and edge or vertex
+    contacts dropped (they lie on a face's border), and of several edge or vertex
+    contacts at one point the first is kept: a sphere on the seams of a flat or convex
+    surface feels one plane. A contact that moves to a neighbouring triangle of the same
+    mesh takes its shear spring along. Returns (force, moment, dissipation, work of the
+    walls) as :func:`wall_contacts`."""
+    T = ti.static(tangent_dim(3))
+    xi = pos[i]
+    ri = prop[i][PROP_RADIUS]
+    r2 = ri * ri
+    capw = wid.shape[1]
+    diss = 0.0
+    work = 0.0
+    ftot = ti.Vector([0.0, 0.0, 0.0])
+    mtot = ti.Vector([0.0, 0.0, 0.0])
+    # meshes (by index) with a face contact; a small fixed set is enough: a sphere
+    # touches faces of few meshes at once (more are counted as having none: their
+    # edge contacts are then kept)
+    faced = ti.Vector([-1, -1, -1, -1])
+    nfaced = 0
+    for s in range(capw):
+        w = wid[i, s]
+        if w < 0:
+            break
+        q, feat = sphere_triangle.closest_point(xi, _tri(wall, w, T_AX), _tri(wall, w, T_BX),
+                                                _tri(wall, w, T_CX))
+        d = q - xi
+        if feat == sphere_triangle.FACE and d.dot(d) < r2 and nfaced < 4:
+            faced[nfaced] = ti.cast(wall[w, T_MESH], ti.i32)
+            nfaced += 1
+    for s in range(capw):
+        w = wid[i, s]
+        if w < 0:
+            break
+        a = _tri(wall, w, T_AX)
+        q, feat = sphere_triangle.closest_point(xi, a, _tri(wall, w, T_BX), _tri(wall, w, T_CX))
+        d = q - xi
+        d2 = d.dot(d)
+        mesh = ti.cast(wall[w, T_MESH], ti.i32)
+        live = d2 < r2
+        if live and feat != sphere_triangle.FACE:
+            for k in ti.static(range(4)):
+                if faced[k] == mesh:
+                    live = False
+            for s2 in range(s):
+                w2 = wid[i, s2]
+                if ti.cast(wall[w2, T_MESH], ti.i32) == mesh:
+                    q2, feat2 = sphere_triangle.closest_point(
+                        xi, _tri(wall, w2, T_AX), _tri(wall, w2, T_BX), _tri(wall, w2, T_CX))
+                    if feat2 != sphere_triangle.FACE and (q2 - q).norm() <= 1e-9 * ri:
+                        live = False
+        h = whist[i, s]
+        if live:
+            if get_first(h, T) == 0.0:
+                # a new contact: a spring of this mesh that stopped touching takes over
+                for s2 in range(capw):
+                    w2 = wid[i, s2]
+                    if w2 >= 0 and s2 != s and ti.cast(wall[w2, T_MESH], ti.i32) == mesh:
+                        h2 = whist[i, s2]
+                        q2, f2 = sphere_triangle.closest_point(
+                            xi, _tri(wall, w2, T_AX), _tri(wall, w2, T_BX),
+                            _tri(wall, w2, T_CX))
+                        if get_first(h2, T) != 0.0 and not (
+                                f2 == sphere_triangle.FACE and (q2 - xi).dot(q2 - xi) < r2):
+                            h = h2
+                            whist[i, s2] = zero_history(h2)
+            dist = ti.sqrt(d2)
+            u = ri - dist
+            n = ti.Vector([0.0, 0.0, -1.0])
+            if dist > 0.0:
+                n = d / dist
+            ai = ri - 0.5 * u
+            xc = xi + ai * n
+            c = _tri(wall, w, T_OX)
+            vw = _tri(wall, w, T_VX) + spin_cross(_tri(wall, w, T_WX), xc - c)
+            vrel = vw - vel[i] - spin_cross(omega[i], ai * n)
+            vn = vrel.dot(n)
+            L = ti.cast(wall[w, T_LAW], ti.i32)
+            h = rotate_tangential(laws, lawp, L, h, n)
+            fn_el, fn, ft, kn, cnd, d1, h = law_force(
+                laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri, dt, h)
+            f = -fn * n + ft
+            mi = moment(ai * n, f)
+            whist[i, s] = h
+            wcn[i, s] = n
+            wcf[i, s] = pack(f, mi, 3)
+            wcs[i, s] = ti.Vector([fn, ft.norm(), u])
+            diss += d1
+            work += f.dot(vw) * dt
+            ftot += f
+            mtot += mi
+            tw = moment(xc - c, -f)
+            for k in ti.static(range(3)):
+                ti.atomic_add(wforce[w][k], -f[k])
+                ti.atomic_add(wforce[w][3 + k], tw[k])
+            ti.atomic_add(wforce[w][6], 1.0)
+        elif get_first(h, T) != 0.0 or wcs[i, s][2] > 0.0:
+            whist[i, s] = zero_history(h)
+            wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+            wcs[i, s] = ti.Vector([0.0, 0.0, ti.min(ri - ti.sqrt(d2), 0.0)])
+    return ftot, mtot, diss, work
+
+
+@ti.func
+def get_first(h, T: ti.template()):
+    """|first T columns|² of a history (the shear spring): zero for a fresh contact."""
+    e = 0.0
+    for c in ti.static(range(T)):
+        e += h[c] * h[c]
+    return e
+
+
+@ti.func
 def servo_velocity(wall: ti.template(), wforce: ti.template(), w, dt):
     """Velocity of a servo-controlled wall (PFC-style): it moves along its direction d
     by relaxation × (target − measured force)/(contacts × k) per step, so that with
@@ -235,7 +381,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
          fext: ti.types.ndarray(), serial: ti.template(), loads: ti.template(),
          detail: ti.template(), continuum: ti.template(), laws: ti.template(),
-         shapes: ti.template()):
+         shapes: ti.template(), dim: ti.template()):
     """One step. ``detail`` (a compile-time switch) also stores what only output
     reads: per-contact normals, scalar forces and overlaps, particle forces, and
     the kinetic and gravitational energy at t_n. The host asks for it on the last
@@ -247,29 +393,32 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     have no DEM contact.
 
     ``loads`` (compile-time): applied forces and moments (``fext``, from
-    :meth:`tdem.Simulation.apply_force`) act on the particles."""
+    :meth:`tdem.Simulation.apply_force`) act on the particles.
+
+    ``dim`` (compile-time): 2 (discs, superellipses, PCMM, segment walls) or 3 (spheres
+    and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D."""
     n = pos.shape[0]
     cap = nbr.shape[1]
     bits = slot_bits(cap)
     dt = simp[P_DT]
     nw = ti.cast(simp[P_NWALLS], ti.i32)
-    g = ti.Vector([simp[P_GX], simp[P_GY]])
+    g = gravity(simp, dim)
     alpha = simp[P_ALPHA]
     alpha_l = simp[P_ALPHA_LOCAL]
     half_skin2 = (0.5 * simp[P_SKIN]) ** 2
-    per = ti.Vector([simp[P_PX0], simp[P_PLX], simp[P_PY0], simp[P_PLY]])
+    per = periodic_axes(simp, dim)
 
     ti.loop_config(serialize=True)
     for w in range(nw):
-        wforce[w] = ti.Vector([0.0, 0.0, 0.0, 0.0])
+        wforce[w] = wforce[w] * 0.0
 
     # 1. contact forces at x_n: each pair once, by its owner (the lower index). On one
     #    thread the partner's share goes straight into its sum; in parallel it is kept
     #    in the slot and gathered in 2. (no atomics, a fixed summation order).
     ti.loop_config(serialize=serial)
     for i in range(n):
-        f = ti.Vector([0.0, 0.0])
-        tq = 0.0
+        f = vec_zero(dim)
+        tq = spin_zero(dim)
         diss = 0.0
         xi = pos[i]
         vi = vel[i]
@@ -288,9 +437,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             shi = shape_of(shp[i], pi[PROP_RADIUS])
             ishaped = shp[i][2] > 0.0
         for k in range(ncnt[i]):
-            fk = ti.Vector([0.0, 0.0])
-            mk = 0.0
-            mjk = 0.0
+            fk = vec_zero(dim)
+            mk = spin_zero(dim)
+            mjk = spin_zero(dim)
             dk = 0.0
             skip = 0
             if ti.static(continuum):
@@ -332,16 +481,24 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             if ti.static(serial):
                 if skip != 1:
                     j = nbr[i, k]
-                    facc[j] += ti.Vector([-fk[0], -fk[1], mjk])
+                    facc[j] += pack(-fk, mjk, dim)
             if ti.static(detail):
-                cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
+                cf[i, k] = pack(fk, mjk, dim)
             elif ti.static(not serial):
                 if skip != 1:      # (a carried pair's share is not read, see 2.)
-                    cf[i, k] = ti.Vector([fk[0], fk[1], mjk])
-        fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
-                                         whist, wcn, wcf, wcs, dt, laws, angle, shp, flags,
-                                         shapes)
-        own = ti.Vector([f[0] + fw[0], f[1] + fw[1], tq + mw])
+                    cf[i, k] = pack(fk, mjk, dim)
+        fw = vec_zero(dim)
+        mw = spin_zero(dim)
+        dw = 0.0
+        work = 0.0
+        if ti.static(dim == 2):
+            fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
+                                             whist, wcn, wcf, wcs, dt, laws, angle, shp, flags,
+                                             shapes)
+        else:
+            fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
+                                             whist, wcn, wcf, wcs, dt, laws)
+        own = pack(f + fw, tq + mw, dim)
         if ti.static(serial):
             facc[i] += own
         else:
@@ -353,11 +510,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     ti.loop_config(serialize=serial)
     for i in range(n):
         a = facc[i]
-        f = ti.Vector([a[0], a[1]])
-        tq = a[2]
+        f, tq = unpack(a, dim)
         # the sums start from zero at every step on either path (the one-thread path
         # adds into them), whichever path the next step takes
-        facc[i] = ti.Vector([0.0, 0.0, 0.0])
+        facc[i] = a * 0.0
         if ti.static(not serial):
             for r in range(rcnt[i]):
                 flat = rev[i, r]
@@ -367,20 +523,21 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if ti.static(continuum):
                     carried = cskip[j, k] == 1
                 if not carried:
-                    c = cf[j, k]
-                    f -= ti.Vector([c[0], c[1]])
-                    tq += c[2]
-        fx_cont = ti.Vector([0.0, 0.0])
+                    cfk, cmk = unpack(cf[j, k], dim)
+                    f -= cfk
+                    tq += cmk
+        fx_cont = vec_zero(dim)
         if ti.static(continuum):
             fx_cont = xforce[i]
         fc = f
         f += fx_cont
         tc = tq
-        fa = ti.Vector([0.0, 0.0, 0.0])
+        fa = vec_zero(dim)
+        ma = spin_zero(dim)
         if ti.static(loads):
-            fa = fext[i]
-            f += ti.Vector([fa[0], fa[1]])
-            tq += fa[2]
+            fa, ma = unpack(fext[i], dim)
+            f += fa
+            tq += ma
         m = prop[i][PROP_MASS]
         inertia = prop[i][PROP_INERTIA]
         v0 = vel[i]
@@ -393,13 +550,16 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         wfree = w1
         fx = fix[i]
         if fx != 0:
-            vf = vfix[i]
-            if fx & 1:
+            vf, wf = unpack(vfix[i], dim)
+            if fx & FIX_VX:
                 v1[0] = vf[0]
-            if fx & 2:
+            if fx & FIX_VY:
                 v1[1] = vf[1]
-            if fx & 4:
-                w1 = vf[2]
+            if ti.static(dim == 3):
+                if fx & FIX_VZ:
+                    v1[2] = vf[2]
+            if fx & FIX_W:
+                w1 = wf
         # the work of each force over the step, F·(v_{n-1/2} + v_{n+1/2})/2 Δt: with
         # the leapfrog's m(v_{n+1/2} − v_{n−1/2}) = ΣF Δt their sum is the change of
         # ½ m v² at the half steps, exactly (round-off apart). The damping force is
@@ -409,34 +569,39 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         wm = 0.5 * (w0 + w1)
         x0 = pos[i]
         w_damp = ((fd - alpha * m * 0.5 * (v0 + vfree)).dot(vm)
-                  + (md - alpha * inertia * 0.5 * (w0 + wfree)) * wm) * dt
-        w_fix = m * (v1 - vfree).dot(vm) + inertia * (w1 - wfree) * wm
-        ework[i] += ti.Vector([(fc.dot(vm) + tc * wm) * dt, fx_cont.dot(vm) * dt,
-                               m * g.dot(vm) * dt, w_damp, w_fix,
-                               (fa[0] * vm[0] + fa[1] * vm[1] + fa[2] * wm) * dt, 0.0])
+                  + spin_dot(md - alpha * inertia * 0.5 * (w0 + wfree), wm, dim)) * dt
+        w_fix = m * (v1 - vfree).dot(vm) + inertia * spin_dot(w1 - wfree, wm, dim)
+        ework[i] += ti.Vector([(fc.dot(vm) + spin_dot(tc, wm, dim)) * dt,
+                               fx_cont.dot(vm) * dt, m * g.dot(vm) * dt, w_damp, w_fix,
+                               (fa.dot(vm) + spin_dot(ma, wm, dim)) * dt, 0.0])
         if alpha != 0.0 or alpha_l != 0.0 or fx != 0:
             eacc[i] += ti.Vector([-w_damp, w_fix])
         if ti.static(detail):
             force[i] = fc + fx_cont
             torque[i] = tc
-            estate[i] = ti.Vector([0.5 * m * vm.dot(vm) + 0.5 * inertia * wm * wm,
+            estate[i] = ti.Vector([0.5 * m * vm.dot(vm) + 0.5 * inertia * spin_dot(wm, wm, dim),
                                    -m * g.dot(x0)])
         x1 = x0 + v1 * dt
         # periodic axes: back into [x0, x0 + L), with the references the displacement
         # and the skin check count from
-        shift = ti.Vector([0.0, 0.0])
-        if per[1] > 0.0:
-            shift[0] = per[1] * ti.floor((x1[0] - per[0]) / per[1])
-        if per[3] > 0.0:
-            shift[1] = per[3] * ti.floor((x1[1] - per[2]) / per[3])
-        if shift[0] != 0.0 or shift[1] != 0.0:
+        shift = vec_zero(dim)
+        moved = False
+        for ax in ti.static(range(dim)):
+            if per[2 * ax + 1] > 0.0:
+                shift[ax] = per[2 * ax + 1] * ti.floor((x1[ax] - per[2 * ax]) / per[2 * ax + 1])
+                if shift[ax] != 0.0:
+                    moved = True
+        if moved:
             x1 -= shift
             xref[i] -= shift
             pos0[i] -= shift
         vel[i] = v1
         omega[i] = w1
         pos[i] = x1
-        angle[i] += w1 * dt
+        if ti.static(dim == 2):
+            angle[i] += w1 * dt
+        else:
+            angle[i] = turn_quaternion(angle[i], w1 * dt)
         dx = x1 - xref[i]
         if dx.dot(dx) > half_skin2:
             flags[F_REBUILD] = 1
@@ -444,33 +609,90 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     # 3. walls move: servo walls first set their speed from the force they received,
     #    then rotation about their centre and translation; a wall that has moved half
     #    the skin since the lists were built asks for a rebuild
-    ti.loop_config(serialize=True)
-    for w in range(nw):
-        if wall[w, W_SERVO_K] > 0.0:
-            wall[w, W_VX], wall[w, W_VY] = servo_velocity(wall, wforce, w, dt)
-        c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
-        v = ti.Vector([wall[w, W_VX], wall[w, W_VY]])
-        ang = wall[w, W_OMEGA] * dt
-        arm = ti.max((ti.Vector([wall[w, W_X0], wall[w, W_Y0]]) - c).norm(),
-                     (ti.Vector([wall[w, W_X1], wall[w, W_Y1]]) - c).norm())
-        wall[w, W_DISP] += (v.norm() + ti.abs(wall[w, W_OMEGA]) * arm) * dt
-        if wall[w, W_DISP] > 0.5 * simp[P_SKIN]:
-            flags[F_REBUILD] = 1
-        rot = ti.Matrix([[ti.cos(ang), -ti.sin(ang)], [ti.sin(ang), ti.cos(ang)]])
-        p0 = c + v * dt + rot @ (ti.Vector([wall[w, W_X0], wall[w, W_Y0]]) - c)
-        p1 = c + v * dt + rot @ (ti.Vector([wall[w, W_X1], wall[w, W_Y1]]) - c)
-        wall[w, W_X0] = p0[0]
-        wall[w, W_Y0] = p0[1]
-        wall[w, W_X1] = p1[0]
-        wall[w, W_Y1] = p1[1]
-        wall[w, W_CX] = c[0] + v[0] * dt
-        wall[w, W_CY] = c[1] + v[1] * dt
+    if ti.static(dim == 3):
+        for w in range(nw):
+            move_triangle(wall, w, dt, simp[P_SKIN], flags)
+    if ti.static(dim == 2):
+        ti.loop_config(serialize=True)
+        for w in range(nw):
+            if wall[w, W_SERVO_K] > 0.0:
+                wall[w, W_VX], wall[w, W_VY] = servo_velocity(wall, wforce, w, dt)
+            c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
+            v = ti.Vector([wall[w, W_VX], wall[w, W_VY]])
+            ang = wall[w, W_OMEGA] * dt
+            arm = ti.max((ti.Vector([wall[w, W_X0], wall[w, W_Y0]]) - c).norm(),
+                         (ti.Vector([wall[w, W_X1], wall[w, W_Y1]]) - c).norm())
+            wall[w, W_DISP] += (v.norm() + ti.abs(wall[w, W_OMEGA]) * arm) * dt
+            if wall[w, W_DISP] > 0.5 * simp[P_SKIN]:
+                flags[F_REBUILD] = 1
+            rot = ti.Matrix([[ti.cos(ang), -ti.sin(ang)], [ti.sin(ang), ti.cos(ang)]])
+            p0 = c + v * dt + rot @ (ti.Vector([wall[w, W_X0], wall[w, W_Y0]]) - c)
+            p1 = c + v * dt + rot @ (ti.Vector([wall[w, W_X1], wall[w, W_Y1]]) - c)
+            wall[w, W_X0] = p0[0]
+            wall[w, W_Y0] = p0[1]
+            wall[w, W_X1] = p1[0]
+            wall[w, W_Y1] = p1[1]
+            wall[w, W_CX] = c[0] + v[0] * dt
+            wall[w, W_CY] = c[1] + v[1] * dt
+
+
+@ti.func
+def turn_quaternion(q, phi):
+    """The unit quaternion q (w, x, y, z) turned by the rotation vector phi (world
+    frame): exp(phi/2) ⊗ q, renormalised."""
+    a = phi.norm()
+    dq = ti.Vector([1.0, 0.0, 0.0, 0.0])
+    if a > 0.0:
+        s = ti.sin(0.5 * a) / a
+        dq = ti.Vector([ti.cos(0.5 * a), s * phi[0], s * phi[1], s * phi[2]])
+    r = ti.Vector([dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
+                   dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
+                   dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
+                   dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]])
+    return r / r.norm()
+
+
+@ti.func
+def rotation_matrix(phi):
+    """The rotation by the vector phi (Rodrigues)."""
+    a = phi.norm()
+    m = ti.Matrix.identity(float, 3)
+    if a > 0.0:
+        k = phi / a
+        kx = ti.Matrix([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+        m += ti.sin(a) * kx + (1.0 - ti.cos(a)) * kx @ kx
+    return m
+
+
+@ti.func
+def move_triangle(wall: ti.template(), w, dt, skin, flags: ti.template()):
+    """3D: mesh triangle w turns about its mesh's centre by ω Δt and translates by
+    v Δt; one that has moved half the skin since the lists were built asks for a
+    rebuild."""
+    if True:
+        v = _tri(wall, w, T_VX)
+        om = _tri(wall, w, T_WX)
+        c = _tri(wall, w, T_OX)
+        if v.dot(v) > 0.0 or om.dot(om) > 0.0:
+            rot = rotation_matrix(om * dt)
+            arm = 0.0
+            for corner in ti.static((T_AX, T_BX, T_CX)):
+                p = _tri(wall, w, corner)
+                arm = ti.max(arm, (p - c).norm())
+                p = c + v * dt + rot @ (p - c)
+                for k in ti.static(range(3)):
+                    wall[w, corner + k] = p[k]
+            for k in ti.static(range(3)):
+                wall[w, T_OX + k] = c[k] + v[k] * dt
+            wall[w, T_DISP] += (v.norm() + om.norm() * arm) * dt
+            if wall[w, T_DISP] > 0.5 * skin:
+                flags[F_REBUILD] = 1
 
 
 @ti.kernel
 def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                     omega: ti.types.ndarray(), prop: ti.types.ndarray(),
-                    flags: ti.types.ndarray(), dt: ti.f64):
+                    flags: ti.types.ndarray(), dt: ti.f64, dim: ti.template()):
     """flags[F_BAD] = smallest index of a particle with a non-finite state or moving
     more than half its radius in one step."""
     n = pos.shape[0]
@@ -479,9 +701,16 @@ def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
         x = pos[i]
         v = vel[i]
         w = omega[i]
-        s = x[0] + x[1] + v[0] + v[1] + w
+        s = x.sum() + v.sum()
+        nw = 0
+        if ti.static(dim == 2):
+            s += w
+            nw = non_finite(w)
+        else:
+            s += w.sum()
+            nw = any_non_finite(w)
         # a bit test: under fast math, `s != s` is folded to False (tdem.finite)
-        bad = any_non_finite(x) + any_non_finite(v) + non_finite(w) > 0 or ti.abs(s) > 1e300
+        bad = any_non_finite(x) + any_non_finite(v) + nw > 0 or ti.abs(s) > 1e300
         if not bad:
             bad = v.norm() * dt > 0.5 * prop[i][PROP_RADIUS]
         if bad:
@@ -495,9 +724,11 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                        cs: ti.types.ndarray(), wall: ti.types.ndarray(),
                        wid: ti.types.ndarray(), whist: ti.types.ndarray(),
                        wcs: ti.types.ndarray(), lawp: ti.types.ndarray(),
-                       lawpair: ti.types.ndarray(), laws: ti.template()) -> ti.f64:
+                       lawpair: ti.types.ndarray(), laws: ti.template(),
+                       dim: ti.template()) -> ti.f64:
     """Energy stored in the springs of every contact (law and rolling)."""
-    R = ti.static(history_width(laws))
+    T = ti.static(tangent_dim(dim))
+    R = ti.static(history_width(laws, T))
     ST = ti.static(R + 5)            # a shaped contact's state: its R* while touching
     WST = ti.static(R + 3)
     total = 0.0
@@ -513,22 +744,25 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                 reff = ri * rj / (ri + rj)
                 if h[ST] > 0.0:
                     reff = h[ST]
-                kn = law_stiffness(laws, lawp, L, u, reff)
-                total += law_energy(laws, lawp, L, u, reff, h, TANGENT_2D) + rolling_energy(
-                    lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
+                total += law_energy(laws, lawp, L, u, reff, h, T)
+                if ti.static(dim == 2):
+                    kn = law_stiffness(laws, lawp, L, u, reff)
+                    total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
         for s in range(wid.shape[1]):
             w = wid[i, s]
             if w >= 0:
                 u = wcs[i, s][2]
                 if u > 0.0:
                     h = whist[i, s]
-                    L = ti.cast(wall[w, W_LAW], ti.i32)
+                    L = ti.cast(wall[w, ti.static(W_LAW if dim == 2 else T_LAW)], ti.i32)
                     reff = ri
-                    if h[WST] > 0.0:
-                        reff = h[WST]
-                    kn = law_stiffness(laws, lawp, L, u, reff)
-                    total += law_energy(laws, lawp, L, u, reff, h, TANGENT_2D) + rolling_energy(
-                        lawp, L, kn, h[R], 2.0 * ri)
+                    if ti.static(dim == 2):
+                        if h[WST] > 0.0:
+                            reff = h[WST]
+                    total += law_energy(laws, lawp, L, u, reff, h, T)
+                    if ti.static(dim == 2):
+                        kn = law_stiffness(laws, lawp, L, u, reff)
+                        total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri)
     return total
 
 

@@ -32,3 +32,64 @@ def tangent_vector(ft, n):
         return ft[0] * perp(n)
     else:
         return ft
+
+
+@ti.func
+def spin_cross(w, r):
+    """ω × r: the velocity of the point at r from the centre of a body spinning at ω
+    (a scalar in 2D, ω(−r_y, r_x); a 3-vector in 3D)."""
+    if ti.static(r.n == 2):
+        return w * perp(r)
+    else:
+        return w.cross(r)
+
+
+@ti.func
+def moment(r, f):
+    """r × f: the moment of the force f at r (a scalar in 2D, a 3-vector in 3D)."""
+    if ti.static(r.n == 2):
+        return r[0] * f[1] - r[1] * f[0]
+    else:
+        return r.cross(f)
+
+
+@ti.func
+def spin_dot(a, b, dim: ti.template()):
+    """a·b of two spins or moments (scalars in 2D, 3-vectors in 3D)."""
+    if ti.static(dim == 2):
+        return a * b
+    else:
+        return a.dot(b)
+
+
+@ti.func
+def spin_zero(dim: ti.template()):
+    """A zero spin or moment (0.0 in 2D, the zero 3-vector in 3D)."""
+    if ti.static(dim == 2):
+        return 0.0
+    else:
+        return ti.Vector([0.0, 0.0, 0.0])
+
+
+@ti.func
+def vec_zero(dim: ti.template()):
+    """The zero vector of ``dim`` components."""
+    return ti.Vector([0.0 for _ in ti.static(range(dim))])
+
+
+@ti.func
+def pack(f, m, dim: ti.template()):
+    """(force, moment) as one vector of dim + spin components (3 in 2D, 6 in 3D)."""
+    if ti.static(dim == 2):
+        return ti.Vector([f[0], f[1], m])
+    else:
+        return ti.Vector([f[0], f[1], f[2], m[0], m[1], m[2]])
+
+
+@ti.func
+def unpack(a, dim: ti.template()):
+    """The (force, moment) of a vector made by :func:`pack`."""
+    if ti.static(dim == 2):
+        return ti.Vector([a[0], a[1]]), a[2]
+    else:
+        return ti.Vector([a[0], a[1], a[2]]), ti.Vector([a[3], a[4], a[5]])

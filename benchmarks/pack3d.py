@@ -1,0 +1,103 @@
+"""Dense 3D sphere pack: the peers' 3D benchmark workload, in tdem.
+
+Same set-up as the peers' input (``liggghts_pack3d.in``): spheres of diameter 4 mm
+on an fcc lattice of touching neighbours (cubic cell 5.657 mm, origin offset 0.36
+cell) filling the block 0.002–0.118 × 0.002–0.118 × 0.002–0.158 m (47,068 spheres),
+resting under gravity in a box 0.12 × 0.12 m (floor and four sides, here a
+triangle mesh of 10 triangles), Hertz–Mindlin with history friction (E = 1e7,
+ν = 0.3, e = 0.5, μ = 0.5), density 2500, Δt = 1e-5 s, skin 0.4 mm, 2,000 warm-up
+steps then N timed steps.
+
+Prints ``PEER tdem <threads> particle_steps_per_s <value>`` like the peers' script
+(``WORKLOAD=pack3d bash peers.sh``).
+
+    python benchmarks/pack3d.py --threads 1            # the 47k workload
+    python benchmarks/pack3d.py --threads 2
+    python benchmarks/pack3d.py --scaling              # 10k ... 500k spheres
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+CELL = 0.0056568542
+
+
+def fcc(hi=(0.118, 0.118, 0.158), lo=(0.002, 0.002, 0.002), cell=CELL, origin=0.36):
+    """The lattice points of LIGGGHTS' ``lattice fcc`` inside the block [lo, hi]."""
+    lo, hi = np.asarray(lo), np.asarray(hi)
+    basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
+    n = np.ceil(hi / cell).astype(int) + 1
+    ijk = np.stack(np.meshgrid(*[np.arange(-1, k) for k in n], indexing="ij"), -1).reshape(-1, 3)
+    pts = ((ijk[:, None, :] + basis[None] + origin) * cell).reshape(-1, 3)
+    keep = np.all((pts >= lo) & (pts <= hi), axis=1)
+    return pts[keep]
+
+
+def build(scale=1.0, arch=None, threads=None):
+    """The workload; ``scale`` widens the box in x and y (the scaling runs)."""
+    import tdem
+    w = 0.12 * math.sqrt(scale)
+    pts = fcc(hi=(w - 0.002, w - 0.002, 0.158))
+    hm = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.5, restitution=0.5)
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=1e-5, arch=arch,
+                          threads=threads, skin=0.0004, check_interval=500, progress=False)
+    sim.add_particles(pts, 0.002, density=2500.0, contact=hm)
+    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w, 0.2))
+    sim.add_mesh(verts, tris, contact=hm)
+    return sim
+
+
+def measure(scale, steps, warmup, arch, threads):
+    sim = build(scale, arch, threads)
+    sim.run(steps=warmup)
+    t = time.perf_counter()
+    sim.run(steps=steps)
+    sim.particles.numpy()  # waits for the device
+    el = time.perf_counter() - t
+    return sim, sim.n_particles * steps / el, el
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--steps", type=int, default=5000)
+    p.add_argument("--warmup", type=int, default=2000)
+    p.add_argument("--arch", default=None)
+    p.add_argument("--scale", type=float, default=1.0,
+                   help="box area × scale (particles × scale)")
+    p.add_argument("--scaling", action="store_true",
+                   help="run about 10k, 47k, 100k, 200k, 500k spheres, one process each")
+    p.add_argument("--json", default=None, help="append the results to this JSON file")
+    args = p.parse_args(argv)
+    if args.scaling:
+        for scale in (0.2125, 1.0, 2.125, 4.25, 10.625):
+            cmd = [sys.executable, __file__, "--threads", str(args.threads), "--steps",
+                   str(args.steps), "--warmup", str(args.warmup), "--scale", str(scale)] + (
+                       ["--arch", args.arch] if args.arch else [])
+            out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
+            print([ln for ln in out.splitlines() if ln.startswith("particles")][-1],
+                  [ln for ln in out.splitlines() if ln.startswith("PEER")][-1], flush=True)
+        return
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+    sim, rate, el = measure(args.scale, args.steps, args.warmup, args.arch, args.threads)
+    s = sim.particles.numpy()
+    print(f"particles {sim.n_particles} steps {args.steps} seconds {el:.3f} "
+          f"zmax {s['position'][:, 2].max() + 0.002:.5f} vz {s['velocity'][:, 2].mean():.3e}")
+    print(f"PEER tdem {args.threads} particle_steps_per_s {rate:.0f}", flush=True)
+    if args.json:
+        rec = {"particles": sim.n_particles, "threads": args.threads, "steps": args.steps,
+               "seconds": el, "particle_steps_per_s": rate, "arch": args.arch or "cpu"}
+        data = json.load(open(args.json)) if os.path.exists(args.json) else []
+        data.append(rec)
+        json.dump(data, open(args.json, "w"), indent=1)
+
+
+if __name__ == "__main__":
+    main()
