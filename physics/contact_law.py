@@ -175,12 +175,18 @@ WALL_TAIL = ("shape_state",)
 
 
 def pair_history_width(laws, tdim=TANGENT_2D):
-    """Width of a particle pair's history vector: law columns, rolling, PAIR_TAIL."""
+    """Width of a particle pair's history vector: law columns, rolling, PAIR_TAIL (in
+    3D the law columns only: rolling, the PCMM hand-over and shapes are 2D)."""
+    if tdim == TANGENT_3D:
+        return history_width(laws, tdim)
     return history_width(laws, tdim) + len(ROLLING_COLUMNS) + len(PAIR_TAIL)
 
 
 def wall_history_width(laws, tdim=TANGENT_2D):
-    """Width of a particle–wall history vector: law columns, rolling, WALL_TAIL."""
+    """Width of a particle–wall history vector: law columns, rolling, WALL_TAIL (in 3D
+    the law columns only)."""
+    if tdim == TANGENT_3D:
+        return history_width(laws, tdim)
     return history_width(laws, tdim) + len(ROLLING_COLUMNS) + len(WALL_TAIL)
 
 
@@ -463,6 +469,21 @@ def tangential_firsts(cls):
 
 
 @ti.func
+def _turned(h, first: ti.template(), n):
+    """h with its tangent-plane column at ``first`` (3D) turned onto the plane normal
+    to n, its magnitude kept."""
+    v = get_columns(h, first, 3)
+    m2 = v.dot(v)
+    if m2 > 0.0:
+        p = v - v.dot(n) * n
+        p2 = p.dot(p)
+        if p2 > 0.0:
+            p *= ti.sqrt(m2 / p2)
+        h = put_columns(h, first, p)
+    return h
+
+
+@ti.func
 def rotate_tangential(laws: ti.template(), lawp: ti.template(), L, h, n):
     """3D: the history ``h`` with each tangent-plane column of the law of row L turned
     onto the plane normal to the current normal n, its magnitude kept (PHYSICS §8:
@@ -471,12 +492,29 @@ def rotate_tangential(laws: ti.template(), lawp: ti.template(), L, h, n):
     for c in ti.static(range(len(laws))):
         if code == c:
             for first in ti.static(tangential_firsts(laws[c])):
-                v = get_columns(h, first, 3)
-                m2 = v.dot(v)
-                if m2 > 0.0:
-                    p = v - v.dot(n) * n
-                    p2 = p.dot(p)
-                    if p2 > 0.0:
-                        p *= ti.sqrt(m2 / p2)
-                    h = put_columns(h, first, p)
+                h = _turned(h, first, n)
     return h
+
+
+@ti.func
+def law_force_3d(laws: ti.template(), lawp: ti.template(), L, u, vn, vt, meff, reff, dt, h,
+                 n):
+    """:func:`law_force` in 3D, the history's tangent-plane columns first turned onto
+    the plane normal to n (:func:`rotate_tangential`), in one dispatch."""
+    code = ti.cast(lawp[L, COL_CODE], ti.i32)
+    fn_el = 0.0
+    fn = 0.0
+    fs_tot = vt * 0.0
+    kn = 0.0
+    cn = 0.0
+    diss = 0.0
+    hout = h
+    for c in ti.static(range(len(laws))):
+        if code == c:
+            hc = h
+            for first in ti.static(tangential_firsts(laws[c])):
+                hc = _turned(hc, first, n)
+            q = _params(laws, c, lawp, L)
+            fn_el, fn, fs_tot, kn, cn, diss, hout = ti.static(laws[c].force)(
+                q, u, vn, vt, meff, reff, dt, hc)
+    return fn_el, fn, fs_tot, kn, cn, diss, hout

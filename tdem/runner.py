@@ -204,9 +204,9 @@ class Runner:
         for k, width in (("hist", _claw.pair_history_width(self._law_set, tdim)),
                          ("whist", _claw.wall_history_width(self._law_set, tdim))):
             if k in state:
-                state[k] = _claw.remap_history(
-                    state[k], width, tail=3 + len(_claw.PAIR_TAIL if k == "hist" else
-                                                  _claw.WALL_TAIL))
+                tail = 0 if self.dim == 3 else 3 + len(_claw.PAIR_TAIL if k == "hist" else
+                                                       _claw.WALL_TAIL)
+                state[k] = _claw.remap_history(state[k], width, tail=tail)
 
     def _upload_laws(self):
         width = _claw.table_width(self._law_set)

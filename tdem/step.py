@@ -14,8 +14,8 @@ Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
 """
 import taichi as ti
 
-from physics.contact_law import (history_width, law_energy, law_force, law_stiffness,
-                                 rotate_tangential, tangent_dim, zero_history)
+from physics.contact_law import (history_width, law_energy, law_force, law_force_3d,
+                                 law_stiffness, tangent_dim, zero_history)
 from physics.geometry import disc_disc, disc_segment, sphere_triangle
 from physics.geometry import superellipse as se
 from physics.geometry.frame import (moment, pack, spin_cross, spin_dot, spin_zero,
@@ -66,7 +66,7 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     ``detail`` also stores the normal, the scalar forces and the overlap (for
     output, stress and energy). The history vector holds the law's columns, the
     rolling couple, rotation and broken flag (from column R) and the overlap offset
-    u0 (the last column)."""
+    u0 (the last column); in 3D only the law's columns."""
     dim = ti.static(xi.n)
     R = ti.static(history_width(laws, tangent_dim(dim)))
     U0 = ti.static(R + 3)
@@ -79,8 +79,11 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     # physics.pcmm.gather, lowered as the two separate): the contact law takes over
     # from the elements without a force jump (no energy from nowhere)
     h = hist[i, k]
-    u0 = ti.min(h[U0], ti.max(u_geo, 0.0))
-    u = u_geo - u0
+    u0 = 0.0
+    u = u_geo
+    if ti.static(dim == 2):
+        u0 = ti.min(h[U0], ti.max(u_geo, 0.0))
+        u = u_geo - u0
     f = vec_zero(dim)
     m_on_i = spin_zero(dim)
     m_on_j = spin_zero(dim)
@@ -92,10 +95,19 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         L = lawpair[li, plaw[j]]
         mj = pj[PROP_MASS]
         reff = ri * rj / (ri + rj)
-        if ti.static(dim == 3):
-            h = rotate_tangential(laws, lawp, L, h, n)
-        fn_el, fn, ft, kn, cnd, d1, h = law_force(
-            laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h)
+        fn_el = 0.0
+        fn = 0.0
+        ft = tangent_part(vrel, n) * 0.0
+        kn = 0.0
+        cnd = 0.0
+        d1 = 0.0
+        if ti.static(dim == 2):
+            fn_el, fn, ft, kn, cnd, d1, h = law_force(
+                laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h)
+        else:
+            fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
+                laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h,
+                n)
         fs_tot = 0.0
         if ti.static(dim == 2):
             fs_tot = ft[0]
@@ -114,15 +126,19 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
             m_on_i = moment(ai * n, f)
             m_on_j = moment(aj * n, f)
             diss = d1
-        h[U0] = u0
+        if ti.static(dim == 2):
+            h[U0] = u0
         hist[i, k] = h
         if ti.static(detail):
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, fs_tot, u])
     else:
-        h = zero_history(h)
-        h[U0] = u0
-        hist[i, k] = h
+        if ti.static(dim == 2):
+            h = zero_history(h)
+            h[U0] = u0
+            hist[i, k] = h
+        elif h.dot(h) != 0.0:
+            hist[i, k] = zero_history(h)
         if ti.static(detail):
             cs[i, k] = ti.Vector([0.0, 0.0, u])
     return f, m_on_i, m_on_j, diss
@@ -313,9 +329,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             vrel = vw - vel[i] - spin_cross(omega[i], ai * n)
             vn = vrel.dot(n)
             L = ti.cast(wall[w, T_LAW], ti.i32)
-            h = rotate_tangential(laws, lawp, L, h, n)
-            fn_el, fn, ft, kn, cnd, d1, h = law_force(
-                laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri, dt, h)
+            fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
+                laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri, dt, h, n)
             f = -fn * n + ft
             mi = moment(ai * n, f)
             whist[i, s] = h
@@ -742,8 +757,9 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                 L = lawpair[plaw[i], plaw[j]]
                 h = hist[i, k]
                 reff = ri * rj / (ri + rj)
-                if h[ST] > 0.0:
-                    reff = h[ST]
+                if ti.static(dim == 2):
+                    if h[ST] > 0.0:
+                        reff = h[ST]
                 total += law_energy(laws, lawp, L, u, reff, h, T)
                 if ti.static(dim == 2):
                     kn = law_stiffness(laws, lawp, L, u, reff)
