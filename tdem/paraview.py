@@ -82,7 +82,7 @@ def _series_in(directory):
 
 
 def view_script(series, field=DEFAULT_FIELD, disc_field=None, title="", png="view.png",
-                size=(1600, 1200), tube=0.25):
+                size=(1600, 1200), tube=0.25, dim=2):
     """The text of a ``view.py`` for the ``series`` {kind: .pvd file name relative to
     the script} (kinds of :data:`KINDS`). ``field``: the colour of elements and blocks;
     ``disc_field``: a particle array to colour discs by (None: plain grey); ``tube``:
@@ -104,6 +104,7 @@ def view_script(series, field=DEFAULT_FIELD, disc_field=None, title="", png="vie
         f"PNG = {str(png)!r}  # beside this script",
         f"SIZE = {[int(size[0]), int(size[1])]!r}  # pixels",
         f"TUBE = {float(tube)!r}  # largest contact tube radius / median disc radius",
+        f"DIM = {int(dim)!r}  # 2: discs seen from +z; 3: spheres and mesh walls in perspective",
     ])
     return _HEADER + settings + "\n" + _BODY
 
@@ -126,6 +127,8 @@ def write_view_script(directory, series=None, field=None, disc_field=None, title
         field = default_field(sim) if sim is not None else DEFAULT_FIELD
     if title is None:
         title = directory.resolve().name
+    if sim is not None and "dim" not in kw:
+        kw["dim"] = getattr(sim, "dim", 2)
     text = view_script(series, field=field, disc_field=disc_field, title=title, **kw)
     path = directory / SCRIPT_NAME
     tmp = directory / (SCRIPT_NAME + ".tmp")
@@ -313,7 +316,7 @@ import sys
 from paraview.simple import (Calculator, ColorBy, Disk, ExtractSurface, GetActiveViewOrCreate,
                              GetAnimationScene, GetColorTransferFunction, GetScalarBar,
                              GlyphWithCustomSource, Hide, PVDReader, Render, SaveScreenshot,
-                             Show, Text, Threshold, Tube)
+                             Show, Sphere, Text, Threshold, Tube)
 
 try:
     HERE = os.path.dirname(os.path.abspath(__file__))
@@ -559,10 +562,20 @@ def main():
             rings.GlyphTransform.Translate = [0.0, 0.0, 0.01]   # over the elements
             shown["rings"] = rings
             info["particles"]["in_elements"] = count(bonded, t)["points"]
-        disk = Disk(registrationName="disc", InnerRadius=0.0, OuterRadius=0.5,
-                    CircumferentialResolution=64, RadialResolution=1)
+        if DIM == 3:
+            disk = Sphere(registrationName="sphere", Radius=0.5, ThetaResolution=24,
+                          PhiResolution=16)
+        else:
+            disk = Disk(registrationName="disc", InnerRadius=0.0, OuterRadius=0.5,
+                        CircumferentialResolution=64, RadialResolution=1)
         discs = disc_glyphs(free, disk, "discs", view, [0.8, 0.8, 0.8])
-        discs.GlyphTransform.Translate = [0.0, 0.0, 0.01]
+        if DIM == 3:
+            GetActiveViewOrCreate("RenderView")
+            srep = Show(discs, view)
+            srep.Interpolation = "Gouraud"
+            srep.Ambient, srep.Diffuse = 0.25, 0.8
+        else:
+            discs.GlyphTransform.Translate = [0.0, 0.0, 0.01]
         shown["particles"] = discs
         info["discs"] = {"bounds": union(bounds(discs, t), bounds(rings, t) if rings else None)}
 
@@ -572,6 +585,18 @@ def main():
         if kind not in readers:
             continue
         assoc, arr = VALID[kind]
+        if DIM == 3 and kind == "walls":
+            # mesh walls: translucent surfaces with their edges (no index array to
+            # threshold on: the placeholder of a mesh-less file is one point)
+            rep = Show(readers[kind], view)
+            rep.SetRepresentationType("Surface With Edges")
+            rep.ColorArrayName = ["POINTS", ""]
+            rep.AmbientColor = rep.DiffuseColor = [0.55, 0.6, 0.7]
+            rep.EdgeColor = [0.3, 0.3, 0.35]
+            rep.Opacity = 0.25
+            shown[kind] = readers[kind]
+            info[kind] = count(readers[kind], t)
+            continue
         src = threshold(readers[kind], assoc, arr, 0.0, kind + "_cells")
         rep = Show(src, view)
         flat(rep)
@@ -620,7 +645,8 @@ def main():
             lut.InvertTransferFunction()
             lut.RescaleTransferFunction(0.0, fmax)
             lut.AutomaticRescaleRangeMode = "Never"
-            colour_bar(view, lut, "normal force (N/m)", not args.no_text)
+            colour_bar(view, lut, "normal force (%s)" % ("N" if DIM == 3 else "N/m"),
+                       not args.no_text)
             info["contacts"]["tube_bounds"] = bounds(tubes, t)
             info["contacts"]["tube_scale"] = scale
             shown["contacts"] = tubes
@@ -682,6 +708,21 @@ def main():
     cx = 0.5 * (box[0] + box[1]) + (scale * aspect * (1.0 - usable[0]) * 0.8 if bars else 0.0)
     cy = 0.5 * (box[2] + box[3]) + (scale * (1.0 - usable[1]) * 0.5 if not args.no_text else 0.0)
     Render(view)            # paraview.simple resets the camera at the first render
+    if DIM == 3:
+        # 3D: a perspective view from the front, above and to the side, fitting the
+        # bodies and the walls
+        for src in shown.values():
+            for ft in frame_times:
+                box = union(box, bounds(src, ft))
+        c = [0.5 * (box[0] + box[1]), 0.5 * (box[2] + box[3]), 0.5 * (box[4] + box[5])]
+        size3 = max(box[1] - box[0], box[3] - box[2], box[5] - box[4], 1e-12)
+        view.CameraFocalPoint = c
+        view.CameraPosition = [c[0] + 1.6 * size3, c[1] - 2.2 * size3, c[2] + 1.3 * size3]
+        view.CameraViewUp = [0.0, 0.0, 1.0]
+        view.CameraViewAngle = 30.0
+        view.ResetCamera(False)
+        info["camera"] = {"focal_point": c, "bounds": box}
+        return _finish(args, view, scene, caption, frame_times, info)
     view.InteractionMode = "2D"
     view.CameraParallelProjection = 1
     view.CameraFocalPoint = [cx, cy, 0.0]
@@ -698,6 +739,11 @@ def main():
         info["rings"] = {"inner_radius": ring_disk.InnerRadius,
                          "radius_pixels": r_typical / pixel}
 
+    return _finish(args, view, scene, caption, frame_times, info)
+
+
+def _finish(args, view, scene, caption, frame_times, info):
+    """Colour bars placed, the screenshots saved, ``info`` written."""
     for k, bar in enumerate(BARS):
         bar.Position = [0.86, 0.55 - 0.42 * k]
 
