@@ -14,7 +14,7 @@ from physics.hertz_mindlin import HertzMindlin
 from physics.linear import LinearContact
 from physics.rolling import RollingResistance
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
-from physics.shapes import Superellipse
+from physics.shapes import Ellipsoid, Superellipse
 
 from . import mesh, pack, surfaces
 from .plot import plot_history
@@ -25,5 +25,5 @@ __version__ = "0.1.0"
 
 __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces", "ContactLaw", "register_law",
            "LinearContact", "HertzMindlin",
-           "RollingResistance", "PointEdge", "Superellipse", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
+           "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history"]

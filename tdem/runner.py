@@ -47,6 +47,15 @@ ANNOUNCE_SECONDS = 30.0
 ANNOUNCE_MEASURE = 0.5
 
 
+def _rotations(q):
+    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) (w, x, y, z)."""
+    w, x, y, z = (np.asarray(q, dtype=float)[:, k] for k in range(4))
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], 1)
+
+
 class Runner:
     """Device state and the run loop of :class:`tdem.Simulation` (module docstring)."""
 
@@ -74,7 +83,7 @@ class Runner:
                 "law_width": _claw.table_width(self._law_set), "cells": ncell,
                 "cell_starts": ncell + 4096, "flags": FLAGS_SIZE, "simp": stepk.SIMP_SIZE,
                 "wall_width": stepk.wall_width(self.dim), "laws_set": self._law_set,
-                "dim": self.dim}
+                "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
         return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
@@ -105,10 +114,23 @@ class Runner:
         work = np.zeros((len(r), 7))
         # the kinetic energy at the start, ½ m v² + ½ I ω²
         w2 = omega * omega if np.ndim(omega) == 1 else np.einsum("ij,ij->i", omega, omega)
+        lmom = np.zeros_like(omega)
+        if self.dim == 3:
+            # ellipsoids: L = R I Rᵀ ω, and ½ ω·L their rotational energy
+            ell = np.asarray(shape)[:, 3] > 0
+            if ell.any():
+                rot = _rotations(np.asarray(angle)[ell])
+                sh = np.asarray(shape)[ell]
+                a2, b2, c2 = sh[:, 0] ** 2, sh[:, 1] ** 2, sh[:, 2] ** 2
+                i3 = np.stack([b2 + c2, a2 + c2, a2 + b2], 1) * (0.2 * np.asarray(m)[ell])[:, None]
+                wb = np.einsum("nji,nj->ni", rot, omega[ell])
+                lmom[ell] = np.einsum("nij,nj->ni", rot, i3 * wb)
+                w2 = w2.copy()
+                w2[ell] = np.einsum("ij,ij->i", omega[ell], lmom[ell]) / np.asarray(inertia)[ell]
         work[:, 6] = 0.5 * (np.asarray(m) * np.einsum("ij,ij->i", vel, vel)
                             + np.asarray(inertia) * w2)
         return schema.fresh_rows(len(r), sizes, {
-            "ework": work, "omega": omega,
+            "ework": work, "omega": omega, "lmom": lmom,
             "pos": pos, "vel": vel, "pos0": pos, "xref": pos, "shp": shape, "angle": angle,
             "prop": np.stack([r, m, inertia], axis=1),
             "plaw": np.broadcast_to(np.asarray(law, np.int32), (len(r),))})
@@ -203,9 +225,19 @@ class Runner:
         tdim = _claw.tangent_dim(self.dim)
         for k, width in (("hist", _claw.pair_history_width(self._law_set, tdim)),
                          ("whist", _claw.wall_history_width(self._law_set, tdim))):
-            if k in state:
-                tail = 0 if self.dim == 3 else 3 + len(_claw.PAIR_TAIL if k == "hist" else
-                                                       _claw.WALL_TAIL)
+            if k in state and self.dim == 3:
+                # 3D: the law's columns kept, an ellipsoid tail (tdem.shaped3d) zeroed
+                # when the width changes (the warm starts are found again)
+                h = np.asarray(state[k])
+                shaped = self._has_shapes
+                width += (4 if k == "hist" else 1) if shaped else 0
+                if h.shape[-1] != width:
+                    out = np.zeros(h.shape[:-1] + (width,), dtype=h.dtype)
+                    keep = min(h.shape[-1], _claw.history_width(self._law_set, tdim))
+                    out[..., :keep] = h[..., :keep]
+                    state[k] = out
+            elif k in state:
+                tail = 3 + len(_claw.PAIR_TAIL if k == "hist" else _claw.WALL_TAIL)
                 state[k] = _claw.remap_history(state[k], width, tail=tail)
 
     def _upload_laws(self):

@@ -24,7 +24,7 @@ from physics import contact_law as _claw
 from physics.contact_law import ContactLaw
 from physics.linear import LinearContact
 from physics.materials import Material, MohrCoulomb
-from physics.shapes import Superellipse, mass_properties
+from physics.shapes import Ellipsoid, Superellipse, mass_properties
 from physics import stability as _stability
 from physics.validate import in_range, indices, non_negative
 
@@ -291,7 +291,10 @@ class Simulation(Runner, Results):
         """
         slot = -1
         if self.dim == 3:
-            self._refuse_2d_only(shape=shape, material=material, angle=angle)
+            if shape is not None and not isinstance(shape, Ellipsoid):
+                raise InputError(f"shape: a 3D simulation takes spheres (radius=) or "
+                                 f"tdem.Ellipsoid(a, b, c); got {shape!r}")
+            self._refuse_2d_only(material=material, angle=angle)
             if contact is not None and getattr(contact, "rolling", None) is not None:
                 raise InputError(f"contact: rolling resistance is 2D only for now; 3D "
                                  f"spheres take a law without rolling= (got {contact!r})")
@@ -299,9 +302,10 @@ class Simulation(Runner, Results):
             raise InputError(f"orientation: a 2D particle's orientation is its angle= "
                              f"(got orientation={orientation!r})")
         if shape is not None:
-            if not isinstance(shape, Superellipse):
+            if self.dim == 2 and not isinstance(shape, Superellipse):
                 raise InputError(f"shape must be a shape such as tdem.Superellipse(a, b, n), got "
-                                 f"{shape!r}")
+                                 f"{shape!r}" + (" (an ellipsoid is 3D: tdem.Simulation(dim=3))"
+                                                 if isinstance(shape, Ellipsoid) else ""))
             if radius is not None:
                 raise InputError(f"radius: a shaped particle's size is its shape's ({shape!r}); "
                                  f"give radius or shape, not both (got radius={radius!r})")
@@ -343,7 +347,11 @@ class Simulation(Runner, Results):
         n = len(pos)
         if n == 0:
             raise InputError("positions must hold at least one particle, got none")
-        if shape is not None:
+        if shape is not None and self.dim == 3:
+            r = np.full(n, shape.bounding_radius)
+            shp = np.tile([shape.a, shape.b, shape.c, 1.0], (n, 1))
+            ang = _quaternions("orientation", orientation, n)
+        elif shape is not None:
             r = np.full(n, shape.bounding_radius)
             shp = np.tile([shape.a, shape.b, shape.n, shape.area], (n, 1))
             ang = np.radians(_per_particle("angle", 0.0 if angle is None else angle, n))

@@ -77,6 +77,8 @@ ENGINE = (
           doc="work done since the start by the contacts, the continuum (elements, "
               "point-edge contacts, viscous boundaries), gravity, damping, prescribed "
               "velocities, applied forces (J/m); kinetic energy at the start (J/m)"),
+    Array("lmom", "particle", {2: 0, 3: 3}, "f", "dynamic",
+          doc="3D: an ellipsoid's angular momentum L_{n-1/2}, world frame (kg m²/s)"),
     Array("fext", "particle", "DS", "f", "setup",
           doc="applied force (N/m) and moment (N m/m), sim.apply_force"),
     Array("ncnt", "particle", "i", "i32", "dynamic", doc="length of the half list"),
@@ -143,7 +145,12 @@ def _comps(a, sizes):
     if c in ("H", "HW"):
         tdim = contact_law.tangent_dim(dim)
         f = contact_law.pair_history_width if c == "H" else contact_law.wall_history_width
-        return f(sizes["laws_set"], tdim)
+        extra = 0
+        if dim == 3 and sizes.get("shaped"):
+            # ellipsoids: a pair keeps its last normal and its state, a wall contact its
+            # Hertz radius (tdem.shaped3d)
+            extra = 4 if c == "H" else 1
+        return f(sizes["laws_set"], tdim) + extra
     if isinstance(c, dict):
         return c[dim]
     return {"D": dim, "S": 0 if dim == 2 else 3, "DS": 3 if dim == 2 else 6,

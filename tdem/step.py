@@ -23,12 +23,13 @@ from physics.geometry.frame import (moment, pack, spin_cross, spin_dot, spin_zer
 from physics.rolling import rolling_couple, rolling_energy
 
 from .finite import any_non_finite, non_finite
-from .integrate import damped_leapfrog
+from .integrate import damped_leapfrog, free_rotation
 from .launch import cached
 from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY,  # noqa: F401
                         P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0, P_PZ0, P_SKIN,
                         SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH, T_OX, T_VX, T_WX,
                         TRI_WIDTH, gravity, image, periodic_axes, slot_bits)
+from . import shaped3d
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
@@ -244,29 +245,58 @@ def _tri(wall: ti.template(), w, c: ti.template()):
 
 
 @ti.func
+def _mesh_geometry(xi, ri, shaped, mat, abc, wall: ti.template(), w):
+    """(touching, depth, n from the particle to the wall, contact point, feature,
+    Hertz radius) of a sphere (radius ri) or an ellipsoid (``shaped``: shape matrix
+    ``mat``, semi-axes ``abc``) against mesh triangle w."""
+    a = _tri(wall, w, T_AX)
+    b = _tri(wall, w, T_BX)
+    c = _tri(wall, w, T_CX)
+    depth = 0.0
+    n = ti.Vector([0.0, 0.0, -1.0])
+    point = xi
+    feat = 0
+    radius = ri
+    if shaped:
+        depth, n, point, feat, radius = shaped3d.mesh_contact(xi, mat, abc, a, b, c)
+    else:
+        q, f = sphere_triangle.closest_point(xi, a, b, c)
+        feat = f
+        d = q - xi
+        dist = d.norm()
+        depth = ri - dist
+        if dist > 0.0:
+            n = d / dist
+        point = xi + (ri - 0.5 * depth) * n
+    return depth > 0.0, depth, n, point, feat, radius
+
+
+@ti.func
 def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
                   prop: ti.template(), wall: ti.template(), wforce: ti.template(),
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
                   wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
-                  laws: ti.template()):
-    """3D: contacts of sphere i with its candidate mesh triangles (wall slots), by the
-    nearest point of each triangle (:mod:`physics.geometry.sphere_triangle`). Of the
-    triangles of one mesh that it touches, face contacts are kept and edge or vertex
-    contacts dropped (they lie on a face's border), and of several edge or vertex
-    contacts at one point the first is kept: a sphere on the seams of a flat or convex
-    surface feels one plane. A contact that moves to a neighbouring triangle of the same
-    mesh takes its shear spring along. Returns (force, moment, dissipation, work of the
-    walls) as :func:`wall_contacts`."""
+                  laws: ti.template(), shaped, mat, abc):
+    """3D: contacts of particle i (a sphere, or an ellipsoid when ``shaped``: shape
+    matrix ``mat``, semi-axes ``abc``) with its candidate mesh triangles (wall slots),
+    by the nearest point of each triangle (:mod:`physics.geometry.sphere_triangle`,
+    :func:`tdem.shaped3d.mesh_contact`). Of the triangles of one mesh that it touches,
+    face contacts are kept and edge or vertex contacts dropped (they lie on a face's
+    border), and of several edge or vertex contacts at one point the first is kept:
+    a particle on the seams of a flat or convex surface feels one plane. A contact that
+    moves to a neighbouring triangle of the same mesh takes its shear spring along.
+    Returns (force, moment, dissipation, work of the walls) as :func:`wall_contacts`.
+    An ellipsoid's wall history keeps its Hertz radius after the law's columns."""
     T = ti.static(tangent_dim(3))
+    RW = ti.static(history_width(laws, T))
     xi = pos[i]
     ri = prop[i][PROP_RADIUS]
-    r2 = ri * ri
     capw = wid.shape[1]
     diss = 0.0
     work = 0.0
     ftot = ti.Vector([0.0, 0.0, 0.0])
     mtot = ti.Vector([0.0, 0.0, 0.0])
-    # meshes (by index) with a face contact; a small fixed set is enough: a sphere
+    # meshes (by index) with a face contact; a small fixed set is enough: a particle
     # touches faces of few meshes at once (more are counted as having none: their
     # edge contacts are then kept)
     faced = ti.Vector([-1, -1, -1, -1])
@@ -275,22 +305,16 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         w = wid[i, s]
         if w < 0:
             break
-        q, feat = sphere_triangle.closest_point(xi, _tri(wall, w, T_AX), _tri(wall, w, T_BX),
-                                                _tri(wall, w, T_CX))
-        d = q - xi
-        if feat == sphere_triangle.FACE and d.dot(d) < r2 and nfaced < 4:
+        touch, depth, n, point, feat, radius = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w)
+        if touch and feat == sphere_triangle.FACE and nfaced < 4:
             faced[nfaced] = ti.cast(wall[w, T_MESH], ti.i32)
             nfaced += 1
     for s in range(capw):
         w = wid[i, s]
         if w < 0:
             break
-        a = _tri(wall, w, T_AX)
-        q, feat = sphere_triangle.closest_point(xi, a, _tri(wall, w, T_BX), _tri(wall, w, T_CX))
-        d = q - xi
-        d2 = d.dot(d)
+        live, depth, n, point, feat, radius = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w)
         mesh = ti.cast(wall[w, T_MESH], ti.i32)
-        live = d2 < r2
         if live and feat != sphere_triangle.FACE:
             for k in ti.static(range(4)):
                 if faced[k] == mesh:
@@ -298,9 +322,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             for s2 in range(s):
                 w2 = wid[i, s2]
                 if ti.cast(wall[w2, T_MESH], ti.i32) == mesh:
-                    q2, feat2 = sphere_triangle.closest_point(
-                        xi, _tri(wall, w2, T_AX), _tri(wall, w2, T_BX), _tri(wall, w2, T_CX))
-                    if feat2 != sphere_triangle.FACE and (q2 - q).norm() <= 1e-9 * ri:
+                    t2, u2, n2, p2, f2, r2 = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w2)
+                    if t2 and f2 != sphere_triangle.FACE and (p2 - point).norm() <= 1e-9 * ri:
                         live = False
         h = whist[i, s]
         if live:
@@ -310,38 +333,34 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                     w2 = wid[i, s2]
                     if w2 >= 0 and s2 != s and ti.cast(wall[w2, T_MESH], ti.i32) == mesh:
                         h2 = whist[i, s2]
-                        q2, f2 = sphere_triangle.closest_point(
-                            xi, _tri(wall, w2, T_AX), _tri(wall, w2, T_BX),
-                            _tri(wall, w2, T_CX))
-                        if get_first(h2, T) != 0.0 and not (
-                                f2 == sphere_triangle.FACE and (q2 - xi).dot(q2 - xi) < r2):
-                            h = h2
-                            whist[i, s2] = zero_history(h2)
-            dist = ti.sqrt(d2)
-            u = ri - dist
-            n = ti.Vector([0.0, 0.0, -1.0])
-            if dist > 0.0:
-                n = d / dist
-            ai = ri - 0.5 * u
-            xc = xi + ai * n
+                        if get_first(h2, T) != 0.0:
+                            t2, u2, n2, p2, f2, r2 = _mesh_geometry(xi, ri, shaped, mat, abc,
+                                                                    wall, w2)
+                            if not (t2 and f2 == sphere_triangle.FACE):
+                                h = h2
+                                whist[i, s2] = zero_history(h2)
+            arm = point - xi
             c = _tri(wall, w, T_OX)
-            vw = _tri(wall, w, T_VX) + spin_cross(_tri(wall, w, T_WX), xc - c)
-            vrel = vw - vel[i] - spin_cross(omega[i], ai * n)
+            vw = _tri(wall, w, T_VX) + spin_cross(_tri(wall, w, T_WX), point - c)
+            vrel = vw - vel[i] - spin_cross(omega[i], arm)
             vn = vrel.dot(n)
             L = ti.cast(wall[w, T_LAW], ti.i32)
             fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
-                laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri, dt, h, n)
+                laws, lawp, L, depth, vn, tangent_part(vrel, n), prop[i][PROP_MASS], radius,
+                dt, h, n)
+            if ti.static(h.n > RW):
+                h[RW] = radius
             f = -fn * n + ft
-            mi = moment(ai * n, f)
+            mi = moment(arm, f)
             whist[i, s] = h
             wcn[i, s] = n
             wcf[i, s] = pack(f, mi, 3)
-            wcs[i, s] = ti.Vector([fn, ft.norm(), u])
+            wcs[i, s] = ti.Vector([fn, ft.norm(), depth])
             diss += d1
             work += f.dot(vw) * dt
             ftot += f
             mtot += mi
-            tw = moment(xc - c, -f)
+            tw = moment(point - c, -f)
             for k in ti.static(range(3)):
                 ti.atomic_add(wforce[w][k], -f[k])
                 ti.atomic_add(wforce[w][3 + k], tw[k])
@@ -349,7 +368,7 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         elif get_first(h, T) != 0.0 or wcs[i, s][2] > 0.0:
             whist[i, s] = zero_history(h)
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-            wcs[i, s] = ti.Vector([0.0, 0.0, ti.min(ri - ti.sqrt(d2), 0.0)])
+            wcs[i, s] = ti.Vector([0.0, 0.0, ti.min(depth, 0.0)])
     return ftot, mtot, diss, work
 
 
@@ -394,7 +413,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
-         fext: ti.types.ndarray(), serial: ti.template(), loads: ti.template(),
+         fext: ti.types.ndarray(), lmom: ti.types.ndarray(), serial: ti.template(),
+         loads: ti.template(),
          detail: ti.template(), continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
     """One step. ``detail`` (a compile-time switch) also stores what only output
@@ -440,16 +460,21 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         wi = omega[i]
         pi = prop[i]
         li = plaw[i]
-        thi = 0.0
         shi = ti.Vector([0.0, 0.0, 0.0])
         ishaped = False
         cthi = 1.0
         sthi = 0.0
-        if ti.static(shapes):
+        mati = ti.Matrix.identity(float, 3)
+        if ti.static(shapes and dim == 2):
             thi = angle[i]
             cthi = ti.cos(thi)
             sthi = ti.sin(thi)
             shi = shape_of(shp[i], pi[PROP_RADIUS])
+            ishaped = shp[i][2] > 0.0
+        if ti.static(shapes and dim == 3):
+            # an ellipsoid's semi-axes and shape matrix (a sphere's: r, r, r)
+            shi = shaped3d.axes_of(shp[i], pi[PROP_RADIUS])
+            mati = shaped3d.el.shape_matrix(shaped3d.frame_of(shp[i], angle[i]), shi)
             ishaped = shp[i][2] > 0.0
         for k in range(ncnt[i]):
             fk = vec_zero(dim)
@@ -475,7 +500,17 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 shaped = False
                 if ti.static(shapes):
                     shaped = ishaped or shp[nbr[i, k]][2] > 0.0
-                if ti.static(shapes):
+                if ti.static(shapes and dim == 3):
+                    if shaped:
+                        fk, mk, mjk, dk = shaped3d.ellipsoid_pair(
+                            i, k, xi, vi, wi, pi[PROP_MASS], li, mati, shi, pos, vel, omega,
+                            prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs, flags, dt,
+                            detail, laws, per)
+                    else:
+                        fk, mk, mjk, dk = pair_contact(
+                            i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
+                            prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws, per)
+                elif ti.static(shapes):
                     if shaped:
                         fk, mk, mjk, dk = shaped_pair(
                             i, k, xi, vi, wi, pi[PROP_MASS], li, cthi, sthi, shi, pi[PROP_RADIUS],
@@ -512,7 +547,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                                              shapes)
         else:
             fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
-                                             whist, wcn, wcf, wcs, dt, laws)
+                                             whist, wcn, wcf, wcs, dt, laws, ishaped, mati, shi)
         own = pack(f + fw, tq + mw, dim)
         if ti.static(serial):
             facc[i] += own
@@ -561,6 +596,24 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         # local and global damping, central differences (tdem.integrate)
         v1, fd = damped_leapfrog(v0, ftot, m, alpha, alpha_l, dt)
         w1, md = damped_leapfrog(w0, tq, inertia, alpha, alpha_l, dt)
+        q1 = angle[i]
+        ell = False
+        lmid = w0 * 0.0
+        if ti.static(shapes and dim == 3):
+            # an ellipsoid: the angular momentum at the half steps (world frame),
+            # the orientation by the splitting of tdem.integrate.free_rotation
+            si = shp[i]
+            if si[2] > 0.0:
+                ell = True
+                a2 = si[0] * si[0]
+                b2 = si[1] * si[1]
+                c2 = si[2] * si[2]
+                inertia3 = ti.Vector([b2 + c2, a2 + c2, a2 + b2]) * (0.2 * m)
+                l1, ml = damped_leapfrog(lmom[i], tq, 1.0, alpha, alpha_l, dt)
+                md = ml
+                lmid = 0.5 * (lmom[i] + l1)
+                q1, w1 = free_rotation(q1, l1, inertia3, shaped3d.el.rotation(q1), dt)
+                lmom[i] = l1
         vfree = v1
         wfree = w1
         fx = fix[i]
@@ -575,6 +628,16 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     v1[2] = vf[2]
             if fx & FIX_W:
                 w1 = wf
+                if ti.static(shapes and dim == 3):
+                    if ell:
+                        q1 = turn_quaternion(angle[i], wf * dt)
+                        si = shp[i]
+                        a2 = si[0] * si[0]
+                        b2 = si[1] * si[1]
+                        c2 = si[2] * si[2]
+                        rot = shaped3d.el.rotation(q1)
+                        lmom[i] = rot @ (ti.Vector([b2 + c2, a2 + c2, a2 + b2]) * (0.2 * m)
+                                         * (rot.transpose() @ wf))
         # the work of each force over the step, F·(v_{n-1/2} + v_{n+1/2})/2 Δt: with
         # the leapfrog's m(v_{n+1/2} − v_{n−1/2}) = ΣF Δt their sum is the change of
         # ½ m v² at the half steps, exactly (round-off apart). The damping force is
@@ -594,8 +657,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         if ti.static(detail):
             force[i] = fc + fx_cont
             torque[i] = tc
-            estate[i] = ti.Vector([0.5 * m * vm.dot(vm) + 0.5 * inertia * spin_dot(wm, wm, dim),
-                                   -m * g.dot(x0)])
+            rot_ke = 0.5 * inertia * spin_dot(wm, wm, dim)
+            if ell:
+                rot_ke = 0.5 * spin_dot(wm, lmid, dim)
+            estate[i] = ti.Vector([0.5 * m * vm.dot(vm) + rot_ke, -m * g.dot(x0)])
         x1 = x0 + v1 * dt
         # periodic axes: back into [x0, x0 + L), with the references the displacement
         # and the skin check count from
@@ -615,6 +680,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         pos[i] = x1
         if ti.static(dim == 2):
             angle[i] += w1 * dt
+        elif ell:
+            angle[i] = q1
         else:
             angle[i] = turn_quaternion(angle[i], w1 * dt)
         dx = x1 - xref[i]
