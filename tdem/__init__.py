@@ -19,11 +19,13 @@ from physics.shapes import Ellipsoid, Superellipse
 from . import mesh, pack, surfaces
 from .plot import plot_history
 from .errors import CapacityError, InputError, InstabilityError
+from .pack import random_orientations
 from .simulation import Block, Mesh, ParticleGroup, Simulation, Wall
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces", "ContactLaw", "register_law",
+__all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
+           "random_orientations", "ContactLaw", "register_law",
            "LinearContact", "HertzMindlin",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history"]

@@ -141,7 +141,8 @@ def write_particles_vtu(sim, path, particles=None):
     p = sim.particles.numpy() if particles is None else particles
     n = len(p["radius"])
     if getattr(sim, "dim", 2) == 3:
-        return _write_spheres_vtu(path, p)
+        return _write_spheres_vtu(path, p, np.concatenate(sim._host["shape"])
+                                  if sim._host["shape"] else np.zeros((0, 4)))
     st = np.zeros((n, 3, 3))
     st[:, :2, :2] = p["stress"]
     st[:, 2, 2] = p["stress_zz"]
@@ -175,12 +176,24 @@ def write_particles_vtu(sim, path, particles=None):
     return path
 
 
-def _write_spheres_vtu(path, p):
-    """3D: one ``vertex`` cell per sphere with its ``radius`` and ``diameter``
-    (ParaView: Glyph of Sphere scaled by diameter — the glyph's radius is 0.5 — or
-    Point Gaussian), ``velocity``, ``omega``, ``orientation`` (unit quaternion w, x, y,
-    z), ``force``, ``torque`` and ``displacement`` as 3-vectors."""
+def _write_spheres_vtu(path, p, shape):
+    """3D: one ``vertex`` cell per sphere or ellipsoid with its ``radius`` (bounding)
+    and ``diameter`` (ParaView: Glyph of Sphere scaled by diameter — the glyph's radius
+    is 0.5 — or Point Gaussian), ``velocity``, ``omega``, ``orientation`` (unit
+    quaternion w, x, y, z), ``force``, ``torque`` and ``displacement`` as 3-vectors.
+    With ellipsoids, ``shape_tensor`` R diag(2a, 2b, 2c) Rᵀ (3 × 3, row-major; 2r I
+    for a sphere): ParaView's *Tensor Glyph* of a Sphere (radius 0.5) with
+    *Extract Eigenvalues* draws each particle as its true ellipsoid."""
     n = len(p["radius"])
+    tensor = None
+    ell = np.asarray(shape)[:, 3] > 0 if len(shape) == n else np.zeros(n, bool)
+    if ell.any():
+        from .runner import _rotations
+        tensor = np.zeros((n, 3, 3))
+        tensor[:] = np.eye(3) * (2.0 * np.asarray(p["radius"]))[:, None, None]
+        rot = _rotations(np.asarray(p["orientation"])[ell])
+        axes = 2.0 * np.asarray(shape)[ell, :3]
+        tensor[ell] = np.einsum("nij,nj,nkj->nik", rot, axes, rot)
     point_data = {
         "id": np.arange(n, dtype=np.int64),
         "radius": np.asarray(p["radius"], dtype=np.float64),
@@ -193,6 +206,9 @@ def _write_spheres_vtu(path, p):
         "torque": _xyz(p["torque"]),
         "displacement": _xyz(p["displacement"]),
     }
+    if tensor is not None:
+        point_data["shape_tensor"] = tensor.reshape(n, 9)
+        point_data["ellipsoid"] = ell.astype(np.int64)
     _write_mesh(path, _xyz(p["position"]), [("vertex", np.arange(n, dtype=np.int64)[:, None])],
                 point_data=point_data)
     return path
@@ -256,7 +272,9 @@ def write_shapes_vtu(sim, path, particles=None):
 
 
 def _has_shapes(sim):
-    return bool(getattr(sim, "_n", 0)) and sim._has_shapes
+    """Whether the model has 2D shaped particles (their polygons file); 3D ellipsoids
+    are drawn from the particles file's shape tensor."""
+    return bool(getattr(sim, "_n", 0)) and getattr(sim, "dim", 2) == 2 and sim._has_shapes
 
 
 def _stress9(s, szz):

@@ -624,3 +624,37 @@ def largest_overlap(positions, radii, among=None):
         return 0.0, -1, -1
     k = int(np.argmax(rel))
     return float(rel[k]), int(i[k]), int(j[k])
+
+
+def random_orientations(n, seed=0):
+    """(n, 4) unit quaternions (w, x, y, z) uniformly distributed over the rotations
+    (Shoemake 1992), for ``add_particles(..., orientation=)`` in 3D."""
+    n = int(n)
+    if n < 0:
+        raise InputError(f"n must be >= 0, got {n!r}")
+    rng = np.random.default_rng(seed)
+    u1, u2, u3 = rng.random((3, n))
+    a, b = np.sqrt(1.0 - u1), np.sqrt(u1)
+    return np.stack([b * np.cos(2 * np.pi * u3), a * np.sin(2 * np.pi * u2),
+                     a * np.cos(2 * np.pi * u2), b * np.sin(2 * np.pi * u3)], axis=1)
+
+
+def lattice3d(lower, upper, radius, kind="fcc"):
+    """Centres of touching spheres of ``radius`` on a ``"fcc"`` or ``"cubic"`` lattice
+    filling the box [lower + radius, upper − radius] (3D)."""
+    lo = np.asarray(lower, dtype=float).reshape(3) + radius
+    hi = np.asarray(upper, dtype=float).reshape(3) - radius
+    if not np.all(hi >= lo):
+        raise InputError(f"upper must exceed lower by at least a diameter on every axis, got "
+                         f"lower={lower!r}, upper={upper!r}, radius={radius!r}")
+    if kind == "cubic":
+        cell, basis = 2.0 * radius, np.zeros((1, 3))
+    elif kind == "fcc":
+        cell = 2.0 * math.sqrt(2.0) * radius
+        basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
+    else:
+        raise InputError(f"kind must be 'fcc' or 'cubic', got {kind!r}")
+    n = np.floor((hi - lo) / cell).astype(int) + 1
+    ijk = np.stack(np.meshgrid(*[np.arange(k) for k in n], indexing="ij"), -1).reshape(-1, 3)
+    pts = ((ijk[:, None, :] + basis[None]) * cell).reshape(-1, 3) + lo
+    return pts[np.all(pts <= hi + 1e-12 * cell, axis=1)]

@@ -316,7 +316,7 @@ import sys
 from paraview.simple import (Calculator, ColorBy, Disk, ExtractSurface, GetActiveViewOrCreate,
                              GetAnimationScene, GetColorTransferFunction, GetScalarBar,
                              GlyphWithCustomSource, Hide, PVDReader, Render, SaveScreenshot,
-                             Show, Sphere, Text, Threshold, Tube)
+                             Show, Sphere, TensorGlyph, Text, Threshold, Tube)
 
 try:
     HERE = os.path.dirname(os.path.abspath(__file__))
@@ -568,7 +568,19 @@ def main():
         else:
             disk = Disk(registrationName="disc", InnerRadius=0.0, OuterRadius=0.5,
                         CircumferentialResolution=64, RadialResolution=1)
-        discs = disc_glyphs(free, disk, "discs", view, [0.8, 0.8, 0.8])
+        if DIM == 3 and "shape_tensor" in src.PointData.keys():
+            # ellipsoids: a sphere of radius 0.5 stretched by the shape tensor's
+            # eigenvalues (the diameters) along its eigenvectors
+            discs = TensorGlyph(registrationName="ellipsoids", Input=src, GlyphType=disk)
+            discs.Tensors = ["POINTS", "shape_tensor"]
+            discs.ExtractEigenvalues = 1
+            discs.ColorGlyphs = 0
+            discs.ScaleFactor = 1.0
+            rep = Show(discs, view)
+            rep.ColorArrayName = ["POINTS", ""]
+            rep.AmbientColor = rep.DiffuseColor = [0.8, 0.8, 0.8]
+        else:
+            discs = disc_glyphs(free, disk, "discs", view, [0.8, 0.8, 0.8])
         if DIM == 3:
             GetActiveViewOrCreate("RenderView")
             srep = Show(discs, view)

@@ -169,6 +169,18 @@ class Results:
         n, overlap u): (R − u/2) n for a disc, its support point less u/2 along n for a
         shape (the midpoint of the two bodies' support points)."""
         arm = (r[ids] - 0.5 * u)[:, None] * n
+        if self.dim == 3 and self._has_shapes and len(ids):
+            # ellipsoids: the support point M n/h(n), less u/2 along n
+            from .runner import _rotations
+            rows = np.concatenate(self._host["shape"])[ids]
+            ell = rows[:, 3] > 0
+            if ell.any():
+                rot = _rotations(self._a["angle"].to_numpy()[ids][ell])
+                m = np.einsum("nij,nj,nkj->nik", rot, rows[ell, :3] ** 2, rot)
+                mn = np.einsum("nij,nj->ni", m, n[ell])
+                h = np.sqrt(np.einsum("ni,ni->n", n[ell], mn))
+                arm[ell] = mn / h[:, None] - 0.5 * u[ell, None] * n[ell]
+            return arm
         if self._has_shapes and len(ids):
             rows = np.concatenate(self._host["shape"])[ids]
             th = self._a["angle"].to_numpy()[ids]
