@@ -79,8 +79,9 @@ Hence, compared with an analytic reference (the checks of summary.json): Test 1 
 e within 3 %), and in Tests 4-8 the points in the sliding regime (tan(theta) at least 5 %
 above (7/2) mu (1 + e)): the rebound tangential velocity and the change of spin within 5 %,
 the normal restitution within 3 %; Test 7's counter-rotating impacts must change neither.
-Shown as curves only: the sticking / micro-slip regime of Tests 4-8 (the paper's
-comparison there is between codes and with Maw's and FEM results, not a closed form).
+Shown as curves only: the sticking / micro-slip regime of Tests 4-8 (no closed form with
+a tangentially compliant contact; the rigid-body lines drawn beside it are not its
+reference).
 
 Decisions the paper leaves open
 -------------------------------
@@ -105,10 +106,10 @@ Decisions the paper leaves open
   (Tests 3-8); the engine's critical step is larger in every test. The spheres start
   two steps of approach apart. No gravity.
 - Restitution: the engine's Hertz dashpot (Tsuji et al. 1992 with the factor that makes
-  the restitution exactly the e asked); Coulomb's limit on the elastic normal force. The
-  total normal force is not let pull (it stays >= 0 at the end of the contact), so with
-  e = 0.5 the elastic force's impulse, and with it the sliding friction impulse, is about
-  0.3 % below m* (1 + e) v_n.
+  the restitution exactly the e asked). Coulomb's limit is on the elastic part of the
+  normal force, whose impulse is not quite m* (1 + e) v_n when the dashpot is strong: with
+  e = 0.5 the sliding friction impulse comes out about 0.3 % below mu m* (1 + e) v_n
+  (with e = 0.98 below 0.01 %).
 - The engine turns a sphere about the contact point at mid-overlap (lever arm R - u/2),
   the rigid-body theory about its surface (R): the spin change of the soft polyethylene
   of Test 5 (u/R near 3 % at 5 m/s) comes out about 1 % below the theory, that of the
