@@ -42,7 +42,8 @@ def test_readme_example_runs(k, tmp_path):
         import tdem
         n = len(tdem.pack.lattice3d((0, 0, 0), (0.1, 0.1, 0.2), 0.0051, kind="cubic"))
         weight = n * 2500 * 4.0 / 3.0 * math.pi * 0.005 * 0.004 * 0.003 * 9.81
-        fz = float(re.findall(r"\[([^\]]*)\]", out.stdout)[0].split()[2])
+        num = r"\s*(-?[0-9.]+(?:e[+-]?[0-9]+)?)"
+        fz = float(re.search(r"\[" + num * 3 + r"\s*\]", out.stdout).group(3))
         assert -fz == pytest.approx(weight, rel=0.01)     # settled: the box carries it
     if "out/cut" in BLOCKS[k]:
         assert (tmp_path / "out/cut/particles.pvd").exists()
