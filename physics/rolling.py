@@ -93,3 +93,81 @@ def rolling_energy(lawp: ti.template(), L, kn, moment, rbar):
         km = kn * b * b / 12.0
         e = 0.5 * moment * moment / km
     return e
+
+
+@ti.func
+def rolling_couple_3d(lawp: ti.template(), L, fn_el, kn, cn, rbar, dw, n, dt, m_old, th_old,
+                      broken):
+    """3D: the rolling couple of one contact, the vector form of Jiang's models (as the
+    EPSD model of LIGGGHTS and Yade's rolling stiffness): the relative rolling rotation
+    is the tangent-plane part of (ω_i − ω_j) Δt (twisting about n is free), the spring
+    couple M (a tangent-plane vector, turned onto the current plane with its magnitude
+    kept, like the shear spring) takes the increment −K_m Δθ_r, Model 1 caps |M| at
+    F_n B/6, Model 2 breaks once the accumulated |θ_r| exceeds 2 F_n/(K_n B), and the
+    rolling dashpot μ_m (module docstring) acts on the rolling rate while the spring is
+    not capped. dw = ω_i − ω_j, n the contact normal. Returns (spring couple, total
+    couple on i, accumulated θ_r, broken flag, dissipated energy)."""
+    delta = lawp[L, COL_ROLL_DELTA]
+    model = ti.cast(lawp[L, COL_ROLL_MODEL], ti.i32)
+    wr = dw - dw.dot(n) * n
+    m = _onto_plane(m_old, n)
+    th = _onto_plane(th_old, n) + wr * dt
+    m_tot = m * 0.0
+    brk = broken
+    diss = 0.0
+    if model > 0 and delta > 0.0 and kn > 0.0:
+        b = delta * rbar
+        km = kn * b * b / 12.0
+        m_prev = m
+        m = m - km * wr * dt
+        limited = False
+        if model == 1:
+            m0 = ti.max(fn_el, 0.0) * b / 6.0
+            mag = m.norm()
+            if mag > m0:
+                mc = m * (m0 / mag)
+                diss += (0.5 * (m_prev + mc)).dot(m - mc) / km
+                m = mc
+                limited = True
+        else:
+            th0 = 2.0 * ti.max(fn_el, 0.0) / (kn * b)
+            if brk > 0.5 or th.norm() > th0:
+                brk = 1.0
+                diss += 0.5 * m_prev.dot(m) / km
+                m = m * 0.0
+                limited = True
+        m_tot = m
+        if lawp[L, COL_ROLL_DAMP] > 0.5 and not limited:
+            mu_m = cn * b * b / 12.0
+            m_tot -= mu_m * wr
+            diss += mu_m * wr.dot(wr) * dt
+    else:
+        m = m * 0.0
+    return m, m_tot, th, brk, diss
+
+
+@ti.func
+def _onto_plane(v, n):
+    """v turned onto the plane normal to n, its magnitude kept."""
+    out = v
+    m2 = v.dot(v)
+    if m2 > 0.0:
+        p = v - v.dot(n) * n
+        p2 = p.dot(p)
+        if p2 > 0.0:
+            out = p * ti.sqrt(m2 / p2)
+        else:
+            out = p
+    return out
+
+
+@ti.func
+def rolling_energy_3d(lawp: ti.template(), L, kn, moment, rbar):
+    """Energy stored in the 3D rolling spring, |M|²/(2 K_m)."""
+    e = 0.0
+    delta = lawp[L, COL_ROLL_DELTA]
+    if delta > 0.0 and kn > 0.0:
+        b = delta * rbar
+        km = kn * b * b / 12.0
+        e = 0.5 * moment.dot(moment) / km
+    return e

@@ -68,6 +68,11 @@ class Runner:
             self._shaped_cache = (len(chunks), any(bool((c[:, 2] > 0).any()) for c in chunks))
         return self._shaped_cache[1]
 
+    @property
+    def _rolling3d(self):
+        """3D with a law of rolling resistance: contacts keep the rolling columns."""
+        return self.dim == 3 and any(law.rolling is not None for law in self._laws)
+
     def _law_table(self):
         nl = max(len(self._laws), 1)
         t = np.zeros((nl, nl), dtype=np.int32)
@@ -83,7 +88,8 @@ class Runner:
                 "law_width": _claw.table_width(self._law_set), "cells": ncell,
                 "cell_starts": ncell + 4096, "flags": FLAGS_SIZE, "simp": stepk.SIMP_SIZE,
                 "wall_width": stepk.wall_width(self.dim), "laws_set": self._law_set,
-                "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes}
+                "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes,
+                "rolling": self._rolling3d}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
         return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
@@ -231,6 +237,7 @@ class Runner:
                 h = np.asarray(state[k])
                 shaped = self._has_shapes
                 width += (4 if k == "hist" else 1) if shaped else 0
+                width += 7 if self._rolling3d else 0
                 if h.shape[-1] != width:
                     out = np.zeros(h.shape[:-1] + (width,), dtype=h.dtype)
                     keep = min(h.shape[-1], _claw.history_width(self._law_set, tdim))

@@ -295,9 +295,13 @@ class Simulation(Runner, Results):
                 raise InputError(f"shape: a 3D simulation takes spheres (radius=) or "
                                  f"tdem.Ellipsoid(a, b, c); got {shape!r}")
             self._refuse_2d_only(material=material, angle=angle)
-            if contact is not None and getattr(contact, "rolling", None) is not None:
-                raise InputError(f"contact: rolling resistance is 2D only for now; 3D "
-                                 f"spheres take a law without rolling= (got {contact!r})")
+            rolls = contact is not None and getattr(contact, "rolling", None) is not None
+            if rolls and (shape is not None or self._has_shapes):
+                raise InputError(f"contact: rolling resistance is for spheres; a model with "
+                                 f"ellipsoids takes laws without rolling= (got {contact!r})")
+            if shape is not None and self._rolling3d:
+                raise InputError("shape: ellipsoids cannot join a model whose laws have "
+                                 "rolling resistance (a sphere feature)")
         elif orientation is not None:
             raise InputError(f"orientation: a 2D particle's orientation is its angle= "
                              f"(got orientation={orientation!r})")

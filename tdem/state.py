@@ -150,6 +150,10 @@ def _comps(a, sizes):
             # ellipsoids: a pair keeps its last normal and its state, a wall contact its
             # Hertz radius (tdem.shaped3d)
             extra = 4 if c == "H" else 1
+        elif dim == 3 and sizes.get("rolling"):
+            # spheres with rolling resistance: the couple and rotation (3-vectors) and
+            # the broken flag (physics.rolling.rolling_couple_3d)
+            extra = 7
         return f(sizes["laws_set"], tdim) + extra
     if isinstance(c, dict):
         return c[dim]

@@ -14,13 +14,15 @@ Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
 """
 import taichi as ti
 
-from physics.contact_law import (history_width, law_energy, law_force, law_force_3d,
-                                 law_stiffness, tangent_dim, zero_history)
+from physics.contact_law import (get_columns, history_width, law_energy, law_force,
+                                 law_force_3d, law_stiffness, put_columns, tangent_dim,
+                                 zero_history)
 from physics.geometry import disc_disc, disc_segment, sphere_triangle
 from physics.geometry import superellipse as se
 from physics.geometry.frame import (moment, pack, spin_cross, spin_dot, spin_zero,
                                     tangent_part, tangent_vector, unpack, vec_zero)
-from physics.rolling import rolling_couple, rolling_energy
+from physics.rolling import (rolling_couple, rolling_couple_3d, rolling_energy,
+                             rolling_energy_3d)
 
 from .finite import any_non_finite, non_finite
 from .integrate import damped_leapfrog, free_rotation
@@ -127,6 +129,17 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
             m_on_i = moment(ai * n, f)
             m_on_j = moment(aj * n, f)
             diss = d1
+            if ti.static(h.n >= R + 7):
+                # rolling resistance (the columns after the law's)
+                m, m_tot, th, brk, d2 = rolling_couple_3d(
+                    lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, n, dt,
+                    get_columns(h, R, 3), get_columns(h, R + 3, 3), h[R + 6])
+                h = put_columns(h, R, m)
+                h = put_columns(h, R + 3, th)
+                h[R + 6] = brk
+                m_on_i += m_tot
+                m_on_j -= m_tot
+                diss += d2
         if ti.static(dim == 2):
             h[U0] = u0
         hist[i, k] = h
@@ -348,10 +361,21 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
                 laws, lawp, L, depth, vn, tangent_part(vrel, n), prop[i][PROP_MASS], radius,
                 dt, h, n)
-            if ti.static(h.n > RW):
-                h[RW] = radius
             f = -fn * n + ft
             mi = moment(arm, f)
+            m_roll = ti.Vector([0.0, 0.0, 0.0])
+            if ti.static(h.n >= RW + 7):
+                # rolling resistance against the wall (r̄ = 2 R_i, Jiang Eq. 11b)
+                m, m_roll, th, brk, d2 = rolling_couple_3d(
+                    lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - _tri(wall, w, T_WX), n, dt,
+                    get_columns(h, RW, 3), get_columns(h, RW + 3, 3), h[RW + 6])
+                h = put_columns(h, RW, m)
+                h = put_columns(h, RW + 3, th)
+                h[RW + 6] = brk
+                mi += m_roll
+                diss += d2
+            elif ti.static(h.n > RW):
+                h[RW] = radius
             whist[i, s] = h
             wcn[i, s] = n
             wcf[i, s] = pack(f, mi, 3)
@@ -360,7 +384,7 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             work += f.dot(vw) * dt
             ftot += f
             mtot += mi
-            tw = moment(point - c, -f)
+            tw = moment(point - c, -f) - m_roll
             for k in ti.static(range(3)):
                 ti.atomic_add(wforce[w][k], -f[k])
                 ti.atomic_add(wforce[w][3 + k], tw[k])
@@ -827,10 +851,17 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                 if ti.static(dim == 2):
                     if h[ST] > 0.0:
                         reff = h[ST]
+                elif ti.static(h.n == R + 4):
+                    if h[R + 3] > 0.0:       # an ellipsoid pair's R* (tdem.shaped3d)
+                        reff = h[R + 3]
                 total += law_energy(laws, lawp, L, u, reff, h, T)
                 if ti.static(dim == 2):
                     kn = law_stiffness(laws, lawp, L, u, reff)
                     total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
+                elif ti.static(h.n >= R + 7):
+                    kn = law_stiffness(laws, lawp, L, u, reff)
+                    total += rolling_energy_3d(lawp, L, kn, get_columns(h, R, 3),
+                                               2.0 * ri * rj / (ri + rj))
         for s in range(wid.shape[1]):
             w = wid[i, s]
             if w >= 0:
@@ -842,10 +873,16 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                     if ti.static(dim == 2):
                         if h[WST] > 0.0:
                             reff = h[WST]
+                    elif ti.static(h.n == R + 1):
+                        if h[R] > 0.0:           # an ellipsoid's Hertz radius
+                            reff = h[R]
                     total += law_energy(laws, lawp, L, u, reff, h, T)
                     if ti.static(dim == 2):
                         kn = law_stiffness(laws, lawp, L, u, reff)
                         total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri)
+                    elif ti.static(h.n >= R + 7):
+                        kn = law_stiffness(laws, lawp, L, u, reff)
+                        total += rolling_energy_3d(lawp, L, kn, get_columns(h, R, 3), 2.0 * ri)
     return total
 
 

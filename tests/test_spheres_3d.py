@@ -214,8 +214,9 @@ def test_3d_inputs_refused_naming_the_argument():
     with pytest.raises(tdem.InputError, match="triangles"):
         sim.add_mesh(np.eye(3), [[0, 1, 5]], contact=hm)
     with pytest.raises(tdem.InputError, match="rolling"):
-        sim.add_particles([[0, 0, 0]], R, contact=tdem.HertzMindlin(
-            young=E, poisson=NU, rolling=tdem.RollingResistance(delta=0.1)))
+        sim.add_particles([[0, 0, 0]], shape=tdem.Ellipsoid(0.01, 0.008, 0.005),
+                          contact=tdem.HertzMindlin(young=E, poisson=NU,
+                                                    rolling=tdem.RollingResistance(delta=0.1)))
     sim2 = tdem.Simulation(progress=False)
     with pytest.raises(tdem.InputError, match=r"positions.*\(N, 2\).*3D array"):
         sim2.add_particles(np.zeros((3, 3)), R, contact=hm)
@@ -303,3 +304,28 @@ def test_3d_output_reads_back(tmp_path):
     contacts = read(files[2])
     assert contacts.GetNumberOfCells() == len(sim.contacts.numpy()["pairs"])
     assert vtk_to_numpy(contacts.GetCellData().GetArray("shear_force")).shape[1] == 3
+
+
+@pytest.mark.parametrize("delta", [0.1, 0.3])
+def test_rolling_resistance_decelerates_a_rolling_sphere(delta):
+    """Jiang's Model 1 in its 3D vector form: once the rolling spring is at its cap
+    M0 = F_n B/6 (B = δ·2R against a wall), a sphere rolling on a plane decelerates at
+    M0/(R (m + I/R²)) = δ g/4.2, and it stops rolling there."""
+    hm = tdem.HertzMindlin(young=E, poisson=NU, friction=0.8, restitution=0.5,
+                           rolling=tdem.RollingResistance(delta=delta, model=1))
+    g = 9.81
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -g), progress=False)
+    sim.add_mesh(*tdem.surfaces.plane((0, 0, 0), (0, 0, 1), 2.0, divisions=8), contact=hm)
+    fn = mass() * g
+    delta_z = (3 * fn / (4 * e_star() * math.sqrt(R))) ** (2 / 3)
+    v0 = 0.5
+    sim.add_particles([[0.0, 0.011, R - delta_z]], R, density=RHO, contact=hm,
+                      velocity=(v0, 0.0, 0.0), omega=(0.0, v0 / R, 0.0))
+    sim.run(until=0.01)
+    vals = record(sim, lambda s: np.concatenate([[s.time], s.particles.numpy()["velocity"][0],
+                                                 s.particles.numpy()["omega"][0]]), 600)
+    t, vx, wy = vals[:, 0], vals[:, 1], vals[:, 5]
+    a = np.polyfit(t, vx, 1)[0]
+    assert -a == pytest.approx(delta * g / 4.2, rel=0.02)
+    np.testing.assert_allclose(wy * R, vx, rtol=5e-3)          # still rolling
+    assert sim.energy()["dissipated"] > 0.0
