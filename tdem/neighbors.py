@@ -41,6 +41,9 @@ F_WALL_NEED = 2  # largest number of wall slots any particle needed
 F_BAD = 3        # smallest index of an unstable particle (n if none)
 F_BUILDS = 4     # number of list builds so far
 F_NONCONV = 5    # shaped-particle contact evaluations whose iteration stopped short
+F_TBIN_NEED = 6  # 3D: entries the triangle bins needed (more than their capacity: the
+                 # build looked at every triangle; the host grows the bins)
+F_TBIN_TOTAL = 7  # 3D: entries of the triangle bins at the last build
 FLAGS_SIZE = 8
 
 # columns of the float parameter array ``simp`` (the step's and the search's)
@@ -151,7 +154,9 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             gridp: ti.types.ndarray(), gridn: ti.types.ndarray(), flags: ti.types.ndarray(),
             wall: ti.types.ndarray(), wid: ti.types.ndarray(), whist: ti.types.ndarray(),
             wid_old: ti.types.ndarray(), whist_old: ti.types.ndarray(), nwalls: ti.i32,
-            skin: ti.f64, simp: ti.types.ndarray(), dim: ti.template()):
+            skin: ti.f64, simp: ti.types.ndarray(), tbin_count: ti.types.ndarray(),
+            tbin_start: ti.types.ndarray(), tbin_items: ti.types.ndarray(),
+            dim: ti.template()):
     n = pos.shape[0]
     cap = nbr.shape[1]
     nx = gridn[0]
@@ -275,7 +280,13 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                     rev[i, b] = rev[i, b - 1]
                     b -= 1
                 rev[i, b] = v
-    # 7. candidate walls (within R + skin), sorted by wall index, history carried over
+    # 7. 3D: the mesh triangles binned into the cells (the broad phase): each triangle
+    #    in every cell its bounding box, widened by a cell (>= R + skin), reaches
+    if ti.static(dim == 3):
+        bin_triangles(wall, nwalls, gridp, gridn, ncell, nx, nrows, flags, tbin_count,
+                      tbin_start, tbin_items)
+    # 8. candidate walls (within R + skin), sorted by wall index, history carried over:
+    #    in 3D the triangles of the particle's cell (all of them if the bins overflowed)
     for i in range(n):
         if flags[F_REBUILD] != 0:
             capw = wid.shape[1]
@@ -285,7 +296,20 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             xi = pos[i]
             cut = prop[i][PROP_RADIUS] + skin
             cnt = 0
-            for w in range(nwalls):
+            first = 0
+            last = nwalls
+            binned = False
+            if ti.static(dim == 3):
+                binned = flags[F_TBIN_TOTAL] <= tbin_items.shape[0]
+                if binned:
+                    c = cell_index(cell_of(xi, gridp, gridn), gridn)
+                    first = tbin_start[c]
+                    last = first + tbin_count[c]
+            for e in range(first, last):
+                w = e
+                if ti.static(dim == 3):
+                    if binned:
+                        w = tbin_items[e]
                 d = wall_offset(wall, w, xi)
                 if d.dot(d) < cut * cut:
                     if cnt < capw:
@@ -293,8 +317,14 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                         for s in range(capw):
                             if wid_old[i, s] == w:
                                 h = whist_old[i, s]
-                        wid[i, cnt] = w
-                        whist[i, cnt] = h
+                        # insertion by wall index (a fixed order whatever the bins')
+                        k = cnt
+                        while k > 0 and wid[i, k - 1] > w:
+                            wid[i, k] = wid[i, k - 1]
+                            whist[i, k] = whist[i, k - 1]
+                            k -= 1
+                        wid[i, k] = w
+                        whist[i, k] = h
                     cnt += 1
             ti.atomic_max(flags[F_WALL_NEED], cnt)
             for s in range(cnt, capw):
@@ -309,6 +339,75 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
         if flags[F_REBUILD] != 0:
             flags[F_BUILDS] += 1
             flags[F_REBUILD] = 0
+
+
+@ti.func
+def bin_triangles(wall: ti.template(), nwalls, gridp: ti.template(), gridn: ti.template(),
+                  ncell, nx, nrows, flags: ti.template(), tbin_count: ti.template(),
+                  tbin_start: ti.template(), tbin_items: ti.template()):
+    """Counting sort of the mesh triangles into the cells their bounding boxes, widened
+    by one cell on every side, overlap (clamped to the grid like the particles); a
+    particle then looks only at its own cell's list. flags[F_TBIN_TOTAL] is the
+    number of entries; more than the bins hold leaves them unfilled (the build then
+    looks at every triangle) and raises flags[F_TBIN_NEED] for the host to grow them."""
+    for c in range(ncell):
+        if flags[F_REBUILD] != 0:
+            tbin_count[c] = 0
+    for w in range(nwalls):
+        if flags[F_REBUILD] != 0:
+            lo, hi = _triangle_cells(wall, w, gridp, gridn)
+            for cz in range(lo[2], hi[2] + 1):
+                for cy in range(lo[1], hi[1] + 1):
+                    for cx in range(lo[0], hi[0] + 1):
+                        ti.atomic_add(tbin_count[cell_index(ti.Vector([cx, cy, cz]), gridn)], 1)
+    for r in range(nrows):
+        if flags[F_REBUILD] != 0:
+            s = 0
+            for cx in range(nx):
+                c = r * nx + cx
+                tbin_start[c] = s
+                s += tbin_count[c]
+            tbin_start[ncell + r] = s
+    ti.loop_config(serialize=True)
+    for r in range(nrows):
+        if flags[F_REBUILD] != 0:
+            if r == 0:
+                flags[F_TBIN_TOTAL] = 0
+            tot = tbin_start[ncell + r]
+            tbin_start[ncell + r] = flags[F_TBIN_TOTAL]
+            flags[F_TBIN_TOTAL] += tot
+    ti.loop_config(serialize=True)
+    for _k in range(1):
+        if flags[F_REBUILD] != 0 and flags[F_TBIN_TOTAL] > tbin_items.shape[0]:
+            ti.atomic_max(flags[F_TBIN_NEED], flags[F_TBIN_TOTAL])
+    for c in range(ncell):
+        if flags[F_REBUILD] != 0 and flags[F_TBIN_TOTAL] <= tbin_items.shape[0]:
+            tbin_start[c] += tbin_start[ncell + c // nx]
+            tbin_count[c] = 0
+    for w in range(nwalls):
+        if flags[F_REBUILD] != 0 and flags[F_TBIN_TOTAL] <= tbin_items.shape[0]:
+            lo, hi = _triangle_cells(wall, w, gridp, gridn)
+            for cz in range(lo[2], hi[2] + 1):
+                for cy in range(lo[1], hi[1] + 1):
+                    for cx in range(lo[0], hi[0] + 1):
+                        c = cell_index(ti.Vector([cx, cy, cz]), gridn)
+                        slot = ti.atomic_add(tbin_count[c], 1)
+                        tbin_items[tbin_start[c] + slot] = w
+
+
+@ti.func
+def _triangle_cells(wall: ti.template(), w, gridp: ti.template(), gridn: ti.template()):
+    """The lower and upper cells (inclusive) of triangle w's bounding box widened by
+    one cell, clamped to the grid."""
+    a = ti.Vector([wall[w, T_AX], wall[w, T_AX + 1], wall[w, T_AX + 2]])
+    b = ti.Vector([wall[w, T_BX], wall[w, T_BX + 1], wall[w, T_BX + 2]])
+    c = ti.Vector([wall[w, T_CX], wall[w, T_CX + 1], wall[w, T_CX + 2]])
+    lo = cell_of(ti.min(a, b, c), gridp, gridn)
+    hi = cell_of(ti.max(a, b, c), gridp, gridn)
+    for k in ti.static(range(3)):
+        lo[k] = ti.max(lo[k] - 1, 0)
+        hi[k] = ti.min(hi[k] + 1, gridn[k] - 1)
+    return lo, hi
 
 
 @ti.kernel

@@ -87,6 +87,9 @@ class Runner:
         return {"n": n, "cap": cap, "capw": capw, "walls": max(nwalls, 1), "laws": nlaws,
                 "law_width": _claw.table_width(self._law_set), "cells": ncell,
                 "cell_starts": ncell + 4096, "flags": FLAGS_SIZE, "simp": stepk.SIMP_SIZE,
+                "tcells": ncell if self.dim == 3 else 1,
+                "tcell_starts": ncell + 4096 if self.dim == 3 else 1,
+                "tbin_cap": 16 * nwalls + 1024 if self.dim == 3 else 1,
                 "wall_width": stepk.wall_width(self.dim), "laws_set": self._law_set,
                 "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes,
                 "rolling": self._rolling3d}
@@ -503,7 +506,23 @@ class Runner:
             return None, None
         return self._step_args(), self._rebuild_args()
 
+    def _sync_triangle_bins(self):
+        """3D: the triangle bins sized like the particle cells (the grid may have been
+        refitted or restored since), and grown when the last build needed more entries."""
+        a = self._a
+        if self.dim != 3 or "tbin_count" not in a:
+            return
+        if a["tbin_count"].shape != a["cell_count"].shape:
+            a["tbin_count"] = ti.ndarray(ti.i32, tuple(a["cell_count"].shape))
+        if a["tbin_start"].shape != a["cell_start"].shape:
+            a["tbin_start"] = ti.ndarray(ti.i32, tuple(a["cell_start"].shape))
+        need = int(a["flags"][neighbors.F_TBIN_NEED])
+        if need > a["tbin_items"].shape[0]:
+            a["tbin_items"] = ti.ndarray(ti.i32, (int(need * 1.5) + 1024,))
+            a["flags"][F_REBUILD] = 1
+
     def _rebuild_args(self):
+        self._sync_triangle_bins()
         return schema.bind(neighbors.rebuild, self._a, sorted_ids=self._a["sorted"],
                            nwalls=len(self._walls_host), skin=float(self.skin), dim=self.dim)
 
