@@ -518,8 +518,8 @@ class Runner:
             a["tbin_start"] = ti.ndarray(ti.i32, tuple(a["cell_start"].shape))
         need = int(a["flags"][neighbors.F_TBIN_NEED])
         if need > a["tbin_items"].shape[0]:
+            # (used from the next build on: the lists of this one are complete)
             a["tbin_items"] = ti.ndarray(ti.i32, (int(need * 1.5) + 1024,))
-            a["flags"][F_REBUILD] = 1
 
     def _rebuild_args(self):
         self._sync_triangle_bins()
