@@ -49,7 +49,7 @@ Reported beside the paper (no pass/fail): the load shares of the measured forces
 both plates beside Mueth's and the q-model's; which model is the closer (the smaller
 Kolmogorov–Smirnov distance) for each plate (the paper: the loading plate fits the
 q-model, the bottom plate Mueth's fit); the contacts on the loading plate at 400 and
-600 kPa (the paper shows their evolution only as a ratio, Fig. 29/33); the share of
+600 kPa (the paper shows them in its Fig. 33 only, no number); the share of
 particles that the cut removes (the paper: 31 of 1500); the kinetic energy over the
 plate's work at the end (how quasi-static the loading is).
 
@@ -726,7 +726,7 @@ def main(argv=None):
         common.check("loading.contacts_400_600kPa", [len(snaps[0]["plate_force"]),
                                                       len(snaps[-1]["plate_force"])],
                      None, None, "", "contacts on the loading plate at the first and the last "
-                     "snapshot (the paper gives its Fig. 33 only as a ratio)"),
+                     "snapshot (the paper shows them in its Fig. 33 only)"),
         common.check("removed_by_cut", info["removed"] / info["particles_before_cut"],
                      PAPER_REMOVED / PAPER_PARTICLES, None, "",
                      "share of the particles above 2.0 m (paper: 31 of 1500)"),
