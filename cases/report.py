@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the order of the tables: the papers' order (docs/cases.md)
 ORDER = ("nine_disc", "photoelastic", "biaxial", "elastic_gravity", "uniaxial_compression",
          "wave_bar", "soil_cutting", "contact_burst", "water_blocks", "plate_loading",
-         "impact_benchmarks")
+         "ellipsoid_compression", "impact_benchmarks")
 #: a few words on each case for the overview table
 WHAT = {
     "nine_disc": "nine discs compressed by four walls (Cundall & Strack)",
@@ -44,6 +44,7 @@ WHAT = {
     "contact_burst": "a TNT charge detonated on soft rock (Feng et al.)",
     "water_blocks": "water released against columns of blocks (Feng et al.)",
     "plate_loading": "a plate pressed into beds of circles and superellipses (Miyata et al.)",
+    "ellipsoid_compression": "ellipsoids under a plate: forces on the plates (Miyata et al.)",
     "impact_benchmarks": "sphere impacts against Hertz and Coulomb theory (Chung & Ooi)",
 }
 
