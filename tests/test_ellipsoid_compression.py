@@ -104,7 +104,7 @@ def tiny():
     compressed by the case's plate to the last snapshot stress, then stopped and
     settled again."""
     hm = ec.law()
-    sim, floor = ec.new_sim(TINY["box"], {"threads": 1}, hm)
+    sim, floor = ec.new_sim(TINY["box"], {}, hm)
     g = np.arange(3) * 0.9 + 0.45
     xy = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
     pos = np.column_stack([xy, np.full(9, ec.SEMI_AXES[2] + 1e-3)])
@@ -160,7 +160,7 @@ def test_tiny_compression_takes_ten_snapshots_and_its_histograms_integrate_to_on
 # ------------------------------------------------------------ the quick preset
 @pytest.mark.slow
 def test_quick_preset(tmp_path):
-    ec.main(["--preset", "quick", "--out", str(tmp_path), "--threads", "1"])
+    ec.main(["--preset", "quick", "--out", str(tmp_path)])
     s = json.loads((tmp_path / "summary.json").read_text())
     assert common.validate(s) == []
     c = common.checks_by_name(s)
