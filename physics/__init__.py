@@ -11,6 +11,8 @@ import tdem  # noqa: F401  (the engine first: these modules use its errors)
 from .contact_law import ContactLaw, register_law
 from .linear import LinearContact
 from .hertz_mindlin import HertzMindlin
+from .volume_contact import VolumeContact
 from .rolling import RollingResistance
 
-__all__ = ["ContactLaw", "register_law", "LinearContact", "HertzMindlin", "RollingResistance"]
+__all__ = ["ContactLaw", "register_law", "LinearContact", "HertzMindlin", "VolumeContact",
+           "RollingResistance"]

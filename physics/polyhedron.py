@@ -92,9 +92,7 @@ class Polyhedron:
             if np.cross(b - a, c - a) @ eq[t, :3] < 0:
                 tris[t] = tris[t][[0, 2, 1]]
         vol, centroid, inertia = _mass_properties(p, tris)
-        moments, axes = np.linalg.eigh(inertia)
-        if np.linalg.det(axes) < 0:
-            axes[:, 2] *= -1.0
+        moments, axes = _principal_axes(inertia)
         self.volume = vol
         self.centroid = centroid                 # in the frame of the points given
         self.rotation = axes                     # body frame -> frame of the points given
@@ -283,6 +281,45 @@ class Polyhedron:
             if len(shape.vertices) == nv:
                 return shape
         raise InputError(f"no convex polyhedron of {nv} vertices found (seed {seed!r})")
+
+
+def _principal_axes(inertia):
+    """(moments, axes as columns) of the inertia tensor, right-handed, the axes as near
+    to the given ones as the tensor allows: among equal moments (a cube, a square
+    prism) the given axes are kept, and the axes are ordered and signed as the given
+    x, y, z they lie nearest to (so that a box built along x, y, z keeps its frame)."""
+    from scipy.optimize import linear_sum_assignment
+
+    moments, axes = np.linalg.eigh(inertia)
+    scale = max(abs(moments).max(), 1e-300)
+    groups, k = [], 0
+    while k < 3:
+        g = [k]
+        while g[-1] + 1 < 3 and moments[g[-1] + 1] - moments[g[0]] <= 1e-9 * scale:
+            g.append(g[-1] + 1)
+        groups.append(g)
+        k = g[-1] + 1
+    eye = np.eye(3)
+    for g in groups:
+        if len(g) == 3:
+            axes = eye.copy()
+        elif len(g) == 2:
+            q = axes[:, g]
+            proj = q @ q.T @ eye                    # the given axes projected on the plane
+            a1 = proj[:, int(np.argmax(np.linalg.norm(proj, axis=0)))]
+            a1 /= np.linalg.norm(a1)
+            other = [k for k in range(3) if k not in g][0]
+            a2 = np.cross(axes[:, other], a1)
+            axes[:, g[0]], axes[:, g[1]] = a1, a2
+    rows, cols = linear_sum_assignment(-np.abs(axes))   # axis j of the body -> given rows[j]
+    order = np.empty(3, int)
+    order[rows] = cols
+    axes = axes[:, order]
+    moments = moments[order]
+    axes *= np.where(np.diag(axes) < 0, -1.0, 1.0)
+    if np.linalg.det(axes) < 0:
+        axes[:, 2] *= -1.0
+    return moments, axes
 
 
 def _mass_properties(p, tris):

@@ -259,22 +259,28 @@ class Ellipsoid:
         return min(self.a, self.b, self.c)
 
 
-def mass_properties(rows, density, radius, dim=2):
+def mass_properties(rows, density, radius, dim=2, polyhedra=()):
     """(mass, inertia) per unit thickness of particles with host shape ``rows`` (N, 4)
     = (a, b, n, area), n = 0 for a disc of radius ``radius``; in 3D (``dim`` 3) of
-    spheres: 4/3 π R³ ρ and 2/5 m R²."""
+    spheres: 4/3 π R³ ρ and 2/5 m R²; of ellipsoids (a, b, c, 1) and of polyhedra
+    (I₁/m, I₂/m, I₃/m, −(k + 1)), k the index in ``polyhedra``."""
     rows = np.asarray(rows, dtype=float).reshape(-1, 4)
     rho = np.asarray(density, dtype=float)
     r = np.asarray(radius, dtype=float)
     if dim == 3:
-        # spheres; an ellipsoid (flag in the 4th column) has the mass of its volume
-        # and, as its scalar inertia, the mean principal moment (the step takes the
-        # principal moments from its semi-axes)
+        # spheres; an ellipsoid (flag in the 4th column) or a polyhedron has the mass of
+        # its volume and, as its scalar inertia, the mean principal moment (the step
+        # takes the principal moments from the shape row)
         ell = rows[:, 3] > 0
+        poly = rows[:, 3] < 0
         a, b, c = rows[:, 0], rows[:, 1], rows[:, 2]
         vol = np.where(ell, 4.0 / 3.0 * np.pi * a * b * c, 4.0 / 3.0 * np.pi * r ** 3)
+        if poly.any():
+            vols = np.array([p.volume for p in polyhedra])
+            vol = np.where(poly, vols[np.maximum(-rows[:, 3].astype(int) - 1, 0)], vol)
         m = rho * vol
         inertia = np.where(ell, m * (a * a + b * b + c * c) * 2.0 / 15.0, 0.4 * m * r ** 2)
+        inertia = np.where(poly, m * (a + b + c) / 3.0, inertia)
         return m, inertia
     m = rho * np.pi * r ** 2
     inertia = 0.5 * m * r ** 2
@@ -290,7 +296,22 @@ def mass_properties(rows, density, radius, dim=2):
     return m, inertia
 
 
-SHAPES = {"superellipse": Superellipse, "ellipsoid": Ellipsoid}
+def _polyhedron(**kw):
+    from .polyhedron import Polyhedron
+    return Polyhedron(**kw)
+
+
+def principal_inertia(rows, mass):
+    """Principal moments (N, 3) of ellipsoids (rows (a, b, c, 1)) and polyhedra (rows
+    (I₁/m, I₂/m, I₃/m, −(k + 1))) of masses ``mass`` (N,)."""
+    rows = np.asarray(rows, dtype=float).reshape(-1, 4)
+    m = np.asarray(mass, dtype=float)[:, None]
+    a2, b2, c2 = rows[:, 0] ** 2, rows[:, 1] ** 2, rows[:, 2] ** 2
+    ell = np.stack([b2 + c2, a2 + c2, a2 + b2], 1) * 0.2
+    return np.where(rows[:, 3:4] > 0, ell, rows[:, :3]) * m
+
+
+SHAPES = {"superellipse": Superellipse, "ellipsoid": Ellipsoid, "polyhedron": _polyhedron}
 
 
 def from_dict(d):

@@ -1,7 +1,7 @@
 """tdem: continuum–discontinuum simulation in geomechanics, on Taichi.
 
 The public API (see docs/api.md): :class:`Simulation`, the contact laws
-:class:`LinearContact`, :class:`HertzMindlin`, :class:`RollingResistance` (and
+:class:`LinearContact`, :class:`HertzMindlin`, :class:`VolumeContact` (polyhedra), :class:`RollingResistance` (and
 :class:`ContactLaw` with :func:`register_law` for laws of one's own), the
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
@@ -12,8 +12,10 @@ from coupling.point_edge import PointEdge
 from physics.contact_law import ContactLaw, register_law
 from physics.hertz_mindlin import HertzMindlin
 from physics.linear import LinearContact
+from physics.volume_contact import VolumeContact
 from physics.rolling import RollingResistance
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
+from physics.polyhedron import Polyhedron
 from physics.shapes import Ellipsoid, Superellipse
 
 from . import mesh, pack, surfaces
@@ -26,6 +28,6 @@ __version__ = "0.1.0"
 
 __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "random_orientations", "ContactLaw", "register_law",
-           "LinearContact", "HertzMindlin",
+           "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history"]

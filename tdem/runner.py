@@ -27,7 +27,7 @@ import numpy as np
 import taichi as ti
 
 from physics import contact_law as _claw
-from physics.shapes import mass_properties
+from physics.shapes import mass_properties, principal_inertia
 
 from . import backend, neighbors
 from . import state as schema
@@ -69,6 +69,28 @@ class Runner:
         return self._shaped_cache[1]
 
     @property
+    def _shape_code(self):
+        """The step kernel's ``shapes`` bits (tdem.step.SHAPES_*): which shape code
+        it compiles."""
+        if not self._has_shapes:
+            return 0
+        rows = np.concatenate(self._host["shape"])
+        code = 0
+        if self.dim == 2 or (rows[:, 3] > 0).any():
+            code |= stepk.SHAPES_SMOOTH
+        if self.dim == 3 and (rows[:, 3] < 0).any():
+            code |= stepk.SHAPES_POLY
+        return code
+
+    def _upload_polyhedra(self):
+        """The shape tables of the polyhedra (physics.polyhedron), one row each."""
+        if not self._polys:
+            return
+        rows = [p.table_rows() for p in self._polys]
+        self._a["ptab"].from_numpy(np.stack([r[0] for r in rows]))
+        self._a["pint"].from_numpy(np.stack([r[1] for r in rows]).astype(np.int32))
+
+    @property
     def _rolling3d(self):
         """3D with a law of rolling resistance: contacts keep the rolling columns."""
         return self.dim == 3 and any(law.rolling is not None for law in self._laws)
@@ -92,7 +114,7 @@ class Runner:
                 "tbin_cap": 16 * nwalls + 1024 if self.dim == 3 else 1,
                 "wall_width": stepk.wall_width(self.dim), "laws_set": self._law_set,
                 "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes,
-                "rolling": self._rolling3d}
+                "rolling": self._rolling3d, "pshapes": max(len(self._polys), 1)}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
         return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
@@ -104,7 +126,7 @@ class Runner:
         r = np.concatenate(self._host["radius"])
         rho = np.concatenate(self._host["density"])
         shape = np.concatenate(self._host["shape"])
-        m, inertia = mass_properties(shape, rho, r, self.dim)
+        m, inertia = mass_properties(shape, rho, r, self.dim, self._polys)
         if self._cont is not None and self._cont.has_pcmm:
             pm = self._cont.masses
             inertia = np.where(np.isnan(pm), inertia, 0.5 * pm * r ** 2)
@@ -125,13 +147,11 @@ class Runner:
         w2 = omega * omega if np.ndim(omega) == 1 else np.einsum("ij,ij->i", omega, omega)
         lmom = np.zeros_like(omega)
         if self.dim == 3:
-            # ellipsoids: L = R I Rᵀ ω, and ½ ω·L their rotational energy
-            ell = np.asarray(shape)[:, 3] > 0
+            # ellipsoids and polyhedra: L = R I Rᵀ ω, and ½ ω·L their rotational energy
+            ell = np.asarray(shape)[:, 3] != 0
             if ell.any():
                 rot = _rotations(np.asarray(angle)[ell])
-                sh = np.asarray(shape)[ell]
-                a2, b2, c2 = sh[:, 0] ** 2, sh[:, 1] ** 2, sh[:, 2] ** 2
-                i3 = np.stack([b2 + c2, a2 + c2, a2 + b2], 1) * (0.2 * np.asarray(m)[ell])[:, None]
+                i3 = principal_inertia(np.asarray(shape)[ell], np.asarray(m)[ell])
                 wb = np.einsum("nji,nj->ni", rot, omega[ell])
                 lmom[ell] = np.einsum("nij,nj->ni", rot, i3 * wb)
                 w2 = w2.copy()
@@ -181,7 +201,7 @@ class Runner:
         self._set_law_set(state)
         if new_particles is not None:
             pos, vel, r, rho, law, shape, ang, om = new_particles
-            m, inertia = mass_properties(shape, rho, r, self.dim)
+            m, inertia = mass_properties(shape, rho, r, self.dim, self._polys)
             n = len(r)
             add = self._new_rows(pos, vel, r, m, inertia, law, shape, ang, om,
                                  state["nbr"].shape[1], state["wid"].shape[1])
@@ -200,6 +220,7 @@ class Runner:
         # sums start from zero every step
         self._a["facc"].from_numpy(np.zeros((n, self._a["facc"].n)))
         self._upload_laws()
+        self._upload_polyhedra()
         self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.wall_width(self.dim)),
                             fresh=True)
         self._fit_grid(force=True)
@@ -559,7 +580,7 @@ class Runner:
             cont.viscous_boundaries(self)
         if self._n:
             stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set,
-                       self._has_shapes, self.dim)
+                       self._shape_code, self.dim)
         if cont is not None:
             cont.integrate(self)
         self._time += dt

@@ -24,7 +24,9 @@ from physics import contact_law as _claw
 from physics.contact_law import ContactLaw
 from physics.linear import LinearContact
 from physics.materials import Material, MohrCoulomb
+from physics.polyhedron import Polyhedron
 from physics.shapes import Ellipsoid, Superellipse, mass_properties
+from physics.volume_contact import VolumeContact
 from physics import stability as _stability
 from physics.validate import in_range, indices, non_negative
 
@@ -175,6 +177,7 @@ class Simulation(Runner, Results):
         self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat", "shape",
                                       "angle", "omega")}
         self._shaped_cache = None
+        self._polys = []          # the distinct polyhedra (their index: the shape tables' row)
         self._nonconv_reported = 0
         self._account0 = None      # the energy account after the first step (Results.energy)
         self._loads = []           # apply_force calls: (ids, fx, fy, moment)
@@ -291,9 +294,11 @@ class Simulation(Runner, Results):
         """
         slot = -1
         if self.dim == 3:
-            if shape is not None and not isinstance(shape, Ellipsoid):
-                raise InputError(f"shape: a 3D simulation takes spheres (radius=) or "
-                                 f"tdem.Ellipsoid(a, b, c); got {shape!r}")
+            if shape is not None and not isinstance(shape, (Ellipsoid, Polyhedron)):
+                raise InputError(f"shape: a 3D simulation takes spheres (radius=), "
+                                 f"tdem.Ellipsoid(a, b, c) or tdem.Polyhedron(vertices); got "
+                                 f"{shape!r}")
+            self._check_polyhedral(shape, contact)
             self._refuse_2d_only(material=material, angle=angle)
             rolls = contact is not None and getattr(contact, "rolling", None) is not None
             if rolls and (shape is not None or self._has_shapes):
@@ -351,7 +356,12 @@ class Simulation(Runner, Results):
         n = len(pos)
         if n == 0:
             raise InputError("positions must hold at least one particle, got none")
-        if shape is not None and self.dim == 3:
+        if isinstance(shape, Polyhedron):
+            r = np.full(n, shape.bounding_radius)
+            k = next((k for k, p in enumerate(self._polys) if p == shape), len(self._polys))
+            shp = np.tile(list(shape.principal_moments) + [-(k + 1.0)], (n, 1))
+            ang = _quaternions("orientation", orientation, n)
+        elif shape is not None and self.dim == 3:
             r = np.full(n, shape.bounding_radius)
             shp = np.tile([shape.a, shape.b, shape.c, 1.0], (n, 1))
             ang = _quaternions("orientation", orientation, n)
@@ -398,6 +408,8 @@ class Simulation(Runner, Results):
         # every check passed: from here on the model changes (the law is checked
         # before it is added)
         law = self._law_id(contact)
+        if isinstance(shape, Polyhedron) and not any(p == shape for p in self._polys):
+            self._polys.append(shape)
         if material is not None:
             slot = self._slot_of(material, tol)
         ids = np.arange(self._n, self._n + n)
@@ -426,9 +438,35 @@ class Simulation(Runner, Results):
             self._host["radius"])
         r[np.concatenate(self._host["mat"]) >= 0] = np.nan
         shp = np.concatenate(self._host["shape"])
+        if self.dim == 3:
+            ell = shp[:, 3] > 0
+            r[ell] = shp[ell, :3].min(axis=1)                     # inscribed spheres
+            poly = shp[:, 3] < 0
+            if poly.any():
+                ins = np.array([p.inscribed_radius for p in self._polys])
+                r[poly] = ins[-shp[poly, 3].astype(int) - 1]
+            return r
         shaped = shp[:, 2] > 0
         r[shaped] = np.minimum(shp[shaped, 0], shp[shaped, 1])    # inscribed circles
         return r
+
+    def _check_polyhedral(self, shape, contact):
+        """Polyhedra take tdem.VolumeContact, and only they do; they do not share a model
+        with ellipsoids (no contact of the two is defined)."""
+        poly = isinstance(shape, Polyhedron)
+        if poly and contact is not None and not isinstance(contact, VolumeContact):
+            raise InputError(f"contact: polyhedra take tdem.VolumeContact(young=, friction=, "
+                             f"restitution=), got {contact!r}")
+        if not poly and isinstance(contact, VolumeContact):
+            raise InputError(f"contact: tdem.VolumeContact is the law of polyhedra (the "
+                             f"overlap volume); spheres and ellipsoids take LinearContact or "
+                             f"HertzMindlin (a sphere–polyhedron pair takes the polyhedron's "
+                             f"law), got {contact!r} for shape={shape!r}")
+        rows = np.concatenate(self._host["shape"]) if self._host["shape"] else np.zeros((0, 4))
+        if (poly and (rows[:, 3] > 0).any()) or (isinstance(shape, Ellipsoid)
+                                                 and (rows[:, 3] < 0).any()):
+            raise InputError(f"shape: ellipsoids and polyhedra cannot share a simulation (no "
+                             f"contact between the two is defined), got {shape!r}")
 
     def _slot_of(self, material, tol):
         for k, (m, t) in enumerate(self._slots):
@@ -938,7 +976,7 @@ class Simulation(Runner, Results):
             return self._a["prop"].to_numpy()[:, 2]
         return mass_properties(np.concatenate(self._host["shape"]),
                                np.concatenate(self._host["density"]), self._radii(),
-                               self.dim)[1]
+                               self.dim, self._polys)[1]
 
     def _masses(self):
         """(radius, mass, law group) of every particle, from the device once built."""
@@ -946,7 +984,8 @@ class Simulation(Runner, Results):
         if self._built:
             return r, self._a["prop"].to_numpy()[:, 1], self._a["plaw"].to_numpy()
         m = mass_properties(np.concatenate(self._host["shape"]),
-                            np.concatenate(self._host["density"]), r, self.dim)[0]
+                            np.concatenate(self._host["density"]), r, self.dim,
+                            self._polys)[0]
         return r, m, np.concatenate(self._host["law"])
 
     def _laws_met(self, plaw):

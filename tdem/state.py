@@ -30,6 +30,7 @@ import taichi as ti
 from taichi.lang import impl
 
 from physics import contact_law
+from physics.polyhedron import PI_WIDTH, PT_WIDTH
 
 from .launch import cached
 
@@ -122,6 +123,10 @@ ENGINE = (
           doc="3D: prefix sums of tbin_count, row totals after the cells"),
     Array("tbin_items", "table", ("tbin_cap",), "i32", "scratch",
           doc="3D: the triangles of each cell, from tbin_start"),
+    Array("ptab", "table", ("pshapes", PT_WIDTH), "f64", "scratch",
+          doc="3D: the polyhedra's vertices, planes, counts (physics.polyhedron.PT_*)"),
+    Array("pint", "table", ("pshapes", PI_WIDTH), "i32", "scratch",
+          doc="3D: the polyhedra's edges and surface triangles (physics.polyhedron.PI_*)"),
     Array("gridp", "table", ("dim2",), "f64", "setup", doc="grid origin, cell sizes"),
     Array("gridn", "table", (4,), "i32", "setup",
           doc="grid cells per axis (nz = 0 in 2D), particles"),

@@ -31,7 +31,7 @@ from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_
                         P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0, P_PZ0, P_SKIN,
                         SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH, T_OX, T_VX, T_WX,
                         TRI_WIDTH, gravity, image, periodic_axes, slot_bits)
-from . import shaped3d
+from . import polyhedra3d, shaped3d
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
@@ -49,6 +49,9 @@ def wall_width(dim):
     """Columns of a row of the wall table: a segment (2D) or a mesh triangle (3D)."""
     return WALL_WIDTH if dim == 2 else TRI_WIDTH
 
+
+# the step's ``shapes`` bits: superellipses (2D) or ellipsoids (3D); polyhedra (3D)
+SHAPES_SMOOTH, SHAPES_POLY = 1, 2
 
 # fixed-velocity bits (FIX_W: every spin component; FIX_VZ: 3D)
 FIX_VX, FIX_VY, FIX_W, FIX_VZ = 1, 2, 4, 8
@@ -437,7 +440,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
-         fext: ti.types.ndarray(), lmom: ti.types.ndarray(), serial: ti.template(),
+         fext: ti.types.ndarray(), lmom: ti.types.ndarray(), ptab: ti.types.ndarray(),
+         pint: ti.types.ndarray(), serial: ti.template(),
          loads: ti.template(),
          detail: ti.template(), continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
@@ -455,7 +459,11 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     :meth:`tdem.Simulation.apply_force`) act on the particles.
 
     ``dim`` (compile-time): 2 (discs, superellipses, PCMM, segment walls) or 3 (spheres
-    and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D."""
+    and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D.
+
+    ``shapes`` (compile-time): 0 without shaped particles, else bits: SHAPES_SMOOTH
+    (superellipses in 2D, ellipsoids in 3D), SHAPES_POLY (polyhedra, 3D; their tables
+    ``ptab``, ``pint``, :mod:`physics.polyhedron`)."""
     n = pos.shape[0]
     cap = nbr.shape[1]
     bits = slot_bits(cap)
@@ -495,11 +503,14 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             sthi = ti.sin(thi)
             shi = shape_of(shp[i], pi[PROP_RADIUS])
             ishaped = shp[i][2] > 0.0
-        if ti.static(shapes and dim == 3):
+        ipoly = False
+        if ti.static(dim == 3 and (shapes & SHAPES_SMOOTH)):
             # an ellipsoid's semi-axes and shape matrix (a sphere's: r, r, r)
             shi = shaped3d.axes_of(shp[i], pi[PROP_RADIUS])
             mati = shaped3d.el.shape_matrix(shaped3d.frame_of(shp[i], angle[i]), shi)
-            ishaped = shp[i][2] > 0.0
+            ishaped = shp[i][3] > 0.0
+        if ti.static(dim == 3 and (shapes & SHAPES_POLY)):
+            ipoly = shp[i][3] < 0.0
         for k in range(ncnt[i]):
             fk = vec_zero(dim)
             mk = spin_zero(dim)
@@ -522,15 +533,26 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
                     hist[i, k] = h0
                 shaped = False
-                if ti.static(shapes):
+                if ti.static(shapes and dim == 2):
                     shaped = ishaped or shp[nbr[i, k]][2] > 0.0
                 if ti.static(shapes and dim == 3):
-                    if shaped:
-                        fk, mk, mjk, dk = shaped3d.ellipsoid_pair(
-                            i, k, xi, vi, wi, pi[PROP_MASS], li, mati, shi, pos, vel, omega,
-                            prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs, flags, dt,
-                            detail, laws, per)
-                    else:
+                    # by the kinds of the two: a polyhedron, an ellipsoid, two spheres
+                    done = False
+                    if ti.static(shapes & SHAPES_POLY):
+                        if ipoly or shp[nbr[i, k]][3] < 0.0:
+                            fk, mk, mjk, dk = polyhedra3d.poly_pair(
+                                i, k, xi, vi, wi, pi[PROP_MASS], li, pos, vel, omega, prop,
+                                plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs, flags, dt,
+                                detail, laws, per, ptab, pint)
+                            done = True
+                    if ti.static(shapes & SHAPES_SMOOTH):
+                        if not done and (ishaped or shp[nbr[i, k]][3] > 0.0):
+                            fk, mk, mjk, dk = shaped3d.ellipsoid_pair(
+                                i, k, xi, vi, wi, pi[PROP_MASS], li, mati, shi, pos, vel,
+                                omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs,
+                                flags, dt, detail, laws, per)
+                            done = True
+                    if not done:
                         fk, mk, mjk, dk = pair_contact(
                             i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
                             prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws, per)
@@ -570,8 +592,19 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                                              whist, wcn, wcf, wcs, dt, laws, angle, shp, flags,
                                              shapes)
         else:
-            fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
-                                             whist, wcn, wcf, wcs, dt, laws, ishaped, mati, shi)
+            if ti.static(shapes & SHAPES_POLY):
+                if ipoly:
+                    fw, mw, dw, work = polyhedra3d.mesh_contacts(
+                        i, pos, vel, omega, prop, angle, shp, wall, wforce, lawp, wid, whist,
+                        wcn, wcf, wcs, flags, dt, laws, ptab, pint)
+                else:
+                    fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce,
+                                                     lawp, wid, whist, wcn, wcf, wcs, dt, laws,
+                                                     ishaped, mati, shi)
+            else:
+                fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce, lawp,
+                                                 wid, whist, wcn, wcf, wcs, dt, laws, ishaped,
+                                                 mati, shi)
         own = pack(f + fw, tq + mw, dim)
         if ti.static(serial):
             facc[i] += own
@@ -627,12 +660,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             # an ellipsoid: the angular momentum at the half steps (world frame),
             # the orientation by the splitting of tdem.integrate.free_rotation
             si = shp[i]
-            if si[2] > 0.0:
+            if si[3] != 0.0:
                 ell = True
-                a2 = si[0] * si[0]
-                b2 = si[1] * si[1]
-                c2 = si[2] * si[2]
-                inertia3 = ti.Vector([b2 + c2, a2 + c2, a2 + b2]) * (0.2 * m)
+                inertia3 = polyhedra3d.principal_inertia(si, m)
                 l1, ml = damped_leapfrog(lmom[i], tq, 1.0, alpha, alpha_l, dt)
                 md = ml
                 lmid = 0.5 * (lmom[i] + l1)
@@ -655,12 +685,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if ti.static(shapes and dim == 3):
                     if ell:
                         q1 = turn_quaternion(angle[i], wf * dt)
-                        si = shp[i]
-                        a2 = si[0] * si[0]
-                        b2 = si[1] * si[1]
-                        c2 = si[2] * si[2]
                         rot = shaped3d.el.rotation(q1)
-                        lmom[i] = rot @ (ti.Vector([b2 + c2, a2 + c2, a2 + b2]) * (0.2 * m)
+                        lmom[i] = rot @ (polyhedra3d.principal_inertia(shp[i], m)
                                          * (rot.transpose() @ wf))
         # the work of each force over the step, F·(v_{n-1/2} + v_{n+1/2})/2 Δt: with
         # the leapfrog's m(v_{n+1/2} − v_{n−1/2}) = ΣF Δt their sum is the change of
