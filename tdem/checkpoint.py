@@ -33,6 +33,8 @@ import warnings
 
 import numpy as np
 
+from physics.polyhedron import Polyhedron
+
 from .continuum import SAVED as CONTINUUM_SAVED
 from . import mesh as _mesh
 from .errors import InputError
@@ -77,6 +79,7 @@ def _config(sim):
         "periodic": [None if p is None else [float(p[0]), float(p[1])] for p in sim._periodic],
         "dim": int(sim.dim),
         "meshes": [[int(a), int(b)] for a, b in sim._meshes],
+        "polyhedra": [p.input_vertices.tolist() for p in getattr(sim, "_polys", [])],
         "account0": sim._account0,
         "couples": [{"ids": None if ids is None else [int(i) for i in ids],
                      "a": None if a is None else int(a.index), "block": int(b.index),
@@ -563,6 +566,7 @@ def load(path, arch=None):
     sim._periodic = [None if p is None else tuple(p)
                      for p in cfg.get("periodic", [None] * sim.dim)]
     sim._meshes = [tuple(m) for m in cfg.get("meshes", [])]
+    sim._polys = [Polyhedron(v) for v in cfg.get("polyhedra", [])]
     sim._fixes = fixes
     sim._n = cfg["n"]
     sim._cap = cfg["cap"]

@@ -245,6 +245,8 @@ def write_shapes_vtu(sim, path, particles=None):
     (m), ``stress`` (Pa, tension-positive, 3×3 with σ_zz = 0) and ``pressure`` (Pa)."""
     p = sim.particles.numpy() if particles is None else particles
     rows = np.concatenate(sim._host["shape"]) if sim._n else np.zeros((0, 4))
+    if sim.dim == 3:
+        return _write_polyhedra_vtu(sim, path, p, rows)
     ids = np.flatnonzero(rows[:, 2] > 0)
     m = SHAPE_OUTLINE
     pts = np.zeros((len(ids), m, 2))
@@ -271,10 +273,48 @@ def write_shapes_vtu(sim, path, particles=None):
     return path
 
 
+def _write_polyhedra_vtu(sim, path, p, rows):
+    """3D: the surface of each polyhedron, its faces' triangles placed and turned (one
+    ``triangle`` cell each; ParaView shows the true shapes as a Surface). Cell data, the
+    particle's: ``id``, ``velocity``, ``omega``, ``force``, ``displacement`` (3-vectors)
+    and ``speed``."""
+    ids = np.flatnonzero(rows[:, 3] < 0)
+    kind = -rows[ids, 3].astype(int) - 1
+    pts, cells, owner = [], [], []
+    offset = 0
+    for k in np.unique(kind):
+        sel = ids[kind == k]
+        x, tri = sim._polys[k].surface(np.asarray(p["position"])[sel],
+                                       np.asarray(p["orientation"])[sel])
+        pts.append(x)
+        cells.append(tri + offset)
+        owner.append(np.repeat(sel, len(sim._polys[k].triangles)))
+        offset += len(x)
+    pts = np.concatenate(pts) if pts else np.zeros((0, 3))
+    cells = np.concatenate(cells).astype(np.int64) if cells else np.zeros((0, 3), np.int64)
+    owner = np.concatenate(owner) if owner else np.zeros(0, np.int64)
+    vel = _xyz(np.asarray(p["velocity"]))[owner]
+    data = {
+        "id": owner.astype(np.int64),
+        "velocity": vel,
+        "speed": np.linalg.norm(vel, axis=1),
+        "omega": _xyz(np.asarray(p["omega"]))[owner],
+        "force": _xyz(np.asarray(p["force"]))[owner],
+        "displacement": _xyz(np.asarray(p["displacement"]))[owner],
+    }
+    _write_mesh(path, pts, [("triangle", cells)], cell_data={k: [v] for k, v in data.items()})
+    return path
+
+
 def _has_shapes(sim):
-    """Whether the model has 2D shaped particles (their polygons file); 3D ellipsoids
-    are drawn from the particles file's shape tensor."""
-    return bool(getattr(sim, "_n", 0)) and getattr(sim, "dim", 2) == 2 and sim._has_shapes
+    """Whether the model has shaped particles drawn as cells of their own: 2D
+    superellipses (polygons) and 3D polyhedra (surfaces); 3D ellipsoids are drawn from
+    the particles file's shape tensor."""
+    if not getattr(sim, "_n", 0) or not sim._has_shapes:
+        return False
+    if getattr(sim, "dim", 2) == 2:
+        return True
+    return bool(getattr(sim, "_polys", None))
 
 
 def _stress9(s, szz):

@@ -730,7 +730,13 @@ class Runner:
         """Say when shaped-particle contacts stopped at the iteration cap (their normal
         and depth are then those of the last iterate)."""
         count = int(self._a["flags"].to_numpy()[neighbors.F_NONCONV])
-        if count > self._nonconv_reported:
+        if count > self._nonconv_reported and self._polys:
+            warnings.warn(f"{count - self._nonconv_reported} contact evaluations of polyhedra "
+                          f"needed more overlap points than the fixed buffers hold ({count} "
+                          "in all, sim.nonconverged_contacts): their volume and normal miss "
+                          "the points left out; a smaller time step or less overlap helps",
+                          RuntimeWarning, stacklevel=3)
+        elif count > self._nonconv_reported:
             warnings.warn(f"{count - self._nonconv_reported} contact evaluations of shaped "
                           f"particles stopped at the iteration cap ({count} in all, "
                           "sim.nonconverged_contacts): their normal is the last iterate's; "
