@@ -15,12 +15,22 @@ Prints ``PEER tdem <threads> particle_steps_per_s <value>`` like the peers' scri
     python benchmarks/pack3d.py --threads 2
     python benchmarks/pack3d.py --scaling              # 10k ... 500k spheres
     python benchmarks/pack3d.py --ellipsoids           # the same bed of ellipsoids
+    python benchmarks/pack3d.py --cubes                # about 20,000 cubes
+    python benchmarks/pack3d.py --cubes --yade         # ... and Yade's Polyhedra on them
 
 ``--ellipsoids``: the same number of ellipsoids of semi-axes 2, 1.6 and 1.2 mm (aspect
 1.67), their axes along x, y, z, on the lattice stretched by (1, 0.8, 0.6): the affine
 image of the sphere pack, so that they touch as the spheres do (an affine map keeps
 contacts), in a box 0.12 × 0.096 m; the same law and steps. Their rate beside the
 spheres'.
+
+``--cubes``: cubes of the spheres' volume (edge 3.224 mm) stacked face to face on a
+simple cubic lattice, 37 × 37 × 15 = 20,535 of them, in the same box under gravity:
+a settled bed where every inner cube has six face contacts (the heaviest contact of
+the overlap-volume law: a full overlap polyhedron per face), with
+``tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5)``; the same steps.
+``--yade`` runs the same bed in Yade's Polyhedra (``yade-batch``-free: ``yade -n -x``)
+on one thread and prints its rate beside tdem's.
 """
 import argparse
 import json
@@ -46,6 +56,77 @@ def fcc(hi=(0.118, 0.118, 0.158), lo=(0.002, 0.002, 0.002), cell=CELL, origin=0.
     return pts[keep]
 
 
+EDGE = (4.0 / 3.0 * math.pi * 0.002 ** 3) ** (1.0 / 3.0)     # a cube of a sphere's volume
+
+
+def cube_lattice(w=0.12, layers=15):
+    """Centres of cubes of edge EDGE stacked face to face in the box [0, w]², 0.05 %
+    apart (exactly touching faces are a degenerate case for Yade's CGAL
+    intersection; gravity closes the gaps in the warm-up)."""
+    a = EDGE * 1.0005
+    k = int(w // a)
+    off = 0.5 * (w - k * a) + 0.5 * EDGE
+    g = np.stack(np.meshgrid(off + a * np.arange(k), off + a * np.arange(k),
+                             0.5 * a + a * np.arange(layers), indexing="ij"), -1)
+    return g.reshape(-1, 3)
+
+
+def build_cubes(arch=None, threads=None):
+    import tdem
+    vol = tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5)
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=1e-5, arch=arch,
+                          threads=threads, skin=0.0004, check_interval=500, progress=False)
+    sim.add_particles(cube_lattice(), shape=tdem.Polyhedron.cube(EDGE), density=2500.0,
+                      contact=vol)
+    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (0.12, 0.12, 0.2))
+    sim.add_mesh(verts, tris, contact=vol)
+    return sim
+
+
+YADE_SCRIPT = """
+import time, numpy as np
+from yade import polyhedra_utils
+O.engines = [ForceResetter(),
+  InsertionSortCollider([Bo1_Polyhedra_Aabb(), Bo1_Facet_Aabb()], verletDist=0.0004),
+  InteractionLoop([Ig2_Polyhedra_Polyhedra_PolyhedraGeom(), Ig2_Facet_Polyhedra_PolyhedraGeom()],
+                  [Ip2_PolyhedraMat_PolyhedraMat_PolyhedraPhys()],
+                  [Law2_PolyhedraGeom_PolyhedraPhys_Volumetric()]),
+  NewtonIntegrator(damping=0.0, gravity=(0, 0, -9.81))]
+mat = PolyhedraMat(density=2500, young=1e7, poisson=0.3, frictionAngle=0.4636)
+O.materials.append(mat)
+e = {edge!r}
+cube = [(x, y, z) for x in (-e/2, e/2) for y in (-e/2, e/2) for z in (-e/2, e/2)]
+for c in {centres!r}:
+    b = polyhedra_utils.polyhedra(mat, v=cube, fixed=False)
+    b.state.pos = c
+    O.bodies.append(b)
+w = 0.12
+for f in [((0,0,0),(w,0,0),(w,w,0)), ((0,0,0),(w,w,0),(0,w,0))]:
+    O.bodies.append(facet(f, material=mat, fixed=True))
+O.dt = 1e-5
+O.run({warmup}, True)
+t = time.time()
+O.run({steps}, True)
+el = time.time() - t
+print("PEER yade-polyhedra 1 particle_steps_per_s %.0f" % (len(O.bodies) * {steps} / el))
+"""
+
+
+def run_yade(steps, warmup):
+    """Yade's Polyhedra on the cube bed (one thread): its particle-steps per second."""
+    import tempfile
+    script = YADE_SCRIPT.format(edge=EDGE, centres=[tuple(map(float, c)) for c in cube_lattice()],
+                                warmup=warmup, steps=steps)
+    with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
+        f.write(script)
+    out = subprocess.run(["yade", "-n", "-x", "-j", "1", f.name], capture_output=True,
+                         text=True)
+    lines = [ln for ln in (out.stdout + out.stderr).splitlines() if ln.startswith("PEER")]
+    if not lines:
+        raise RuntimeError("yade gave no rate:\n" + out.stdout[-2000:] + out.stderr[-2000:])
+    return lines[-1]
+
+
 def build(scale=1.0, arch=None, threads=None, ellipsoids=False):
     """The workload; ``scale`` widens the box in x and y (the scaling runs)."""
     import tdem
@@ -65,8 +146,8 @@ def build(scale=1.0, arch=None, threads=None, ellipsoids=False):
     return sim
 
 
-def measure(scale, steps, warmup, arch, threads, ellipsoids=False):
-    sim = build(scale, arch, threads, ellipsoids)
+def measure(scale, steps, warmup, arch, threads, ellipsoids=False, cubes=False):
+    sim = build_cubes(arch, threads) if cubes else build(scale, arch, threads, ellipsoids)
     sim.run(steps=warmup)
     t = time.perf_counter()
     sim.run(steps=steps)
@@ -88,6 +169,10 @@ def main(argv=None):
                    help="run about 10k, 47k, 100k, 200k, 500k spheres, one process each")
     p.add_argument("--ellipsoids", action="store_true",
                    help="ellipsoids (2, 1.6, 1.2 mm) instead of spheres")
+    p.add_argument("--cubes", action="store_true",
+                   help="about 20,000 cubes stacked face to face (tdem.VolumeContact)")
+    p.add_argument("--yade", action="store_true",
+                   help="with --cubes: also Yade's Polyhedra on the same bed")
     p.add_argument("--json", default=None, help="append the results to this JSON file")
     args = p.parse_args(argv)
     if args.scaling:
@@ -101,14 +186,16 @@ def main(argv=None):
         return
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
     sim, rate, el = measure(args.scale, args.steps, args.warmup, args.arch, args.threads,
-                            args.ellipsoids)
+                            args.ellipsoids, args.cubes)
     s = sim.particles.numpy()
     print(f"particles {sim.n_particles} steps {args.steps} seconds {el:.3f} "
           f"zmax {s['position'][:, 2].max() + 0.002:.5f} vz {s['velocity'][:, 2].mean():.3e}")
-    if args.ellipsoids:
+    if args.ellipsoids or args.cubes:
         print(f"nonconverged {sim.nonconverged_contacts}")
-    print(f"PEER tdem{'-ellipsoids' if args.ellipsoids else ''} {args.threads} "
-          f"particle_steps_per_s {rate:.0f}", flush=True)
+    tag = "-ellipsoids" if args.ellipsoids else "-cubes" if args.cubes else ""
+    print(f"PEER tdem{tag} {args.threads} particle_steps_per_s {rate:.0f}", flush=True)
+    if args.cubes and args.yade:
+        print(run_yade(args.steps, args.warmup), flush=True)
     if args.json:
         rec = {"particles": sim.n_particles, "threads": args.threads, "steps": args.steps,
                "seconds": el, "particle_steps_per_s": rate, "arch": args.arch or "cpu"}

@@ -16,6 +16,10 @@ edge L face to face overlapping by δ have V = L²δ, l_c = L, u = δ: a linear 
 stiffness E·L, whose restitution is exactly the one asked (Miyata Eq. 17). The stored
 energy is that of the spring on u, ½ E l_c u² (exact for face-to-face contacts; the
 force E·V/l_c is not the gradient of an energy when the projected area changes).
+
+The restitution asked is met by face-to-face contacts (|S| = l_c²). A contact of
+smaller projected area (an edge, a vertex, a sphere's cap) is damped less: its
+damping ratio is that of a face contact times sqrt(|S|)/l_c, so it rebounds more.
 """
 import math
 

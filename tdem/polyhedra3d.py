@@ -17,8 +17,9 @@ the pair, the kinematics at the contact point, the law, the force and moments.
 The law (:class:`physics.volume_contact.VolumeContact`) is given the overlap as the
 length u = V/l_c², its rate |S| v_n/l_c² (dV/dt/l_c²) and l_c in place of the radius;
 the normal dashpot's dissipation is booked on the true approach velocity v_n.
-A pair's history keeps, after the law's columns, l_c in the state column (the elastic
-energy reads it); a wall contact keeps l_c after the law's columns.
+A pair's history keeps, after the law's columns, the contact point (from x_i, for
+output) and l_c (the elastic energy reads it); a wall contact keeps l_c after the law's
+columns.
 """
 import taichi as ti
 
@@ -208,6 +209,8 @@ def poly_pair(i, k, xi, vi, wi, mi, li, pos: ti.template(), vel: ti.template(),
         m_on_j = moment(rj_arm, -f)
         # the dashpot works on the approach velocity v_n, not on u̇
         diss = d1 + cnd * un * (vn - un) * dt
+        for q in ti.static(range(3)):
+            h[R + q] = c[q]              # the contact point from x_i (output)
         h[ST] = lc
         hist[i, k] = h
         if ti.static(detail):

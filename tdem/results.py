@@ -14,6 +14,7 @@ from physics.shapes import Superellipse
 
 from . import state as schema
 from . import step as stepk
+from .neighbors import T_AX
 
 
 
@@ -141,7 +142,25 @@ class Results:
             wcf = a["wcf"].to_numpy()[wi, wk, :3]
             fs = np.concatenate([cf + cs[ii, kk, 0][:, None] * normal_dir,
                                  wcf + wcs[wi, wk, 0][:, None] * wn])
+            extra = {}
+            if getattr(self, "_polys", None):
+                # polyhedra: the contact point is the overlap's centroid (a pair keeps
+                # it from the owner in its history; against a triangle the point on the
+                # triangle's plane below the centre), the overlap volume V = u l_c²
+                # (l_c in the history tail)
+                rows = np.concatenate(self._host["shape"])
+                pp = (rows[ii, 3] < 0) | (rows[jj, 3] < 0)
+                R3 = _claw.history_width(self._law_set, 3)
+                pts[pp] = pos[ii[pp]] + hist[ii[pp], kk[pp], R3:R3 + 3]
+                wp = rows[wi, 3] < 0
+                tri0 = a["wall"].to_numpy()[wid[wi[wp], wk[wp]], T_AX:T_AX + 3]
+                xw = pos[wi[wp]]
+                wpts[wp] = xw + np.einsum("ij,ij->i", tri0 - xw, wn[wp])[:, None] * wn[wp]
+                vol = np.where(pp, u * hist[ii, kk, R3 + 3] ** 2, 0.0)
+                wvol = np.where(wp, wu * whist[wi, wk, R3] ** 2, 0.0)
+                extra["volume"] = np.concatenate([vol, wvol])
             return {
+                **extra,
                 "pairs": np.concatenate([np.stack([ii, jj], 1),
                                          np.stack([wi, -1 - wid[wi, wk]], 1)]).astype(np.int64),
                 "normal": np.concatenate([cs[ii, kk, 0], wcs[wi, wk, 0]]),

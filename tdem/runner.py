@@ -28,6 +28,7 @@ import taichi as ti
 
 from physics import contact_law as _claw
 from physics.shapes import mass_properties, principal_inertia
+from physics.volume_contact import VolumeContact
 
 from . import backend, neighbors
 from . import state as schema
@@ -100,7 +101,14 @@ class Runner:
         t = np.zeros((nl, nl), dtype=np.int32)
         for a in range(nl):
             for b in range(nl):
-                t[a, b] = self._pair_override.get((a, b), max(a, b))
+                default = max(a, b)
+                if a < len(self._laws) and b < len(self._laws):
+                    # a sphere–polyhedron pair takes the polyhedron's law (its geometry
+                    # gives the overlap volume)
+                    vol = [k for k in (a, b) if isinstance(self._laws[k], VolumeContact)]
+                    if len(vol) == 1:
+                        default = vol[0]
+                t[a, b] = self._pair_override.get((a, b), default)
         return t
 
     # ------------------------------------------------------------ device state

@@ -714,7 +714,7 @@ class Simulation(Runner, Results):
 
     def set_contact(self, group_a, group_b, contact):
         """Use ``contact`` between particles of two groups (default: the law of the group
-        added later)."""
+        added later; between spheres and polyhedra the polyhedra's VolumeContact)."""
         la = self._law_id(group_a.contact, "group_a")
         lb = self._law_id(group_b.contact, "group_b")
         law = self._law_id(contact)

@@ -31,8 +31,8 @@ an overlap that needs more is reported (``status`` 2) and counted by the engine.
 import taichi as ti
 
 from physics.geometry.ellipsoid import rotation
-from physics.polyhedron import (MAX_FACES, MAX_VERTICES, PI_EDGES, PI_TRIS, PT_LENGTH,
-                                PT_NE, PT_NF, PT_NT, PT_NV, PT_PLANES, PT_VERTS)
+from physics.polyhedron import (MAX_FACES, MAX_VERTICES, PI_EDGES, PT_LENGTH, PT_NE,
+                                PT_NF, PT_NV, PT_PLANES, PT_VERTS)
 
 MAXP = 64        # points of one overlap polyhedron
 MAXFP = 32       # points on one of its faces
