@@ -35,7 +35,7 @@ off its ends and are taken out of the heap (held where they are, counted).
   width of the layer below less 2 h_l / tan(α) (h_l ≈ 0.8 d the layer's thickness, α
   = 0.85 × the wedge heap's measured angle of the same seed, so that the layers do
   not avalanche), particles dropped on a jittered grid 1.3 bounding radii above the
-  surface below them, a layer every 0.12 s; then the same settling.
+  surface below them, a layer every 0.08 s; then the same settling.
 
 Three seeds (orientations, jitter) per heap; Δt = 0.3 of the engine's critical step
 of one contact (the engine's VolumeContact estimate takes the stiffness of a contact
@@ -112,9 +112,9 @@ APEX = 2.0                    # |x| below this (d): "under the apex"
 
 PRESETS = {
     "quick": {"particles": 210, "half_base": 16.0, "seeds": (1, 2, 3), "rows": 1, "release_v": 0.1,
-              "batch_dt": 0.03, "layer_dt": 0.12, "settle_max": 1.5},
+              "batch_dt": 0.03, "layer_dt": 0.08, "settle_max": 1.5},
     "paper": {"particles": 900, "half_base": 34.0, "seeds": (1, 2, 3), "rows": 1, "release_v": 0.1,
-              "batch_dt": 0.03, "layer_dt": 0.12, "settle_max": 3.0},
+              "batch_dt": 0.03, "layer_dt": 0.08, "settle_max": 3.0},
 }
 
 
@@ -455,10 +455,12 @@ def synthetic_cone(angle, half_width, bin_width=BIN, points=4000, seed=0):
     rng = np.random.default_rng(seed)
     t = math.tan(math.radians(angle))
     x = rng.uniform(-half_width, half_width, points)
-    surface = t * (half_width - np.abs(x))
-    z = rng.uniform(0.0, 1.0, points) * surface
-    # each bin's highest top on the surface, at the bin's centre (as a grain would be)
     k = np.floor(x / bin_width)
+    # below the surface at the bin's side away from the apex
+    below = np.clip(t * (half_width - np.abs((k + 0.5) * bin_width) - 0.5 * bin_width),
+                    0.0, None)
+    z = rng.uniform(0.0, 1.0, points) * below
+    # each bin's highest top on the surface, at the bin's centre (as a grain would be)
     xc = (np.unique(k) + 0.5) * bin_width
     xs = np.concatenate([x, xc])
     zs = np.concatenate([z, t * (half_width - np.abs(xc))])
@@ -533,7 +535,7 @@ def run_heap(model, sequence, cfg, opts, seed, angle=None, log=print):
            "pressure_x": px, "pressure": pp, "packing": packing,
            "time_s": heap.sim.time, "settle_s": t_settle, "steps": heap.sim.steps,
            "dt_s": heap.sim.dt, "wall_s": time.perf_counter() - w0,
-           "layer_angle": angle, **m,
+           "layer_angle": angle, "base_top": heap.base_top, **m,
            "balance": (float(m["base_fz"].sum()) + m["floor_fz"]) / m["weight"]}
     log(f"{model.name:7s} {sequence:7s} seed {seed}: {m['grains']} grains "
         f"({m['fallen']} fell off), angle {fmt_angle(angles)}, height "
