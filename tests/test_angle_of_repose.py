@@ -57,8 +57,10 @@ def test_pressure_profile_and_its_shape():
     assert np.sum(p * area) == pytest.approx(f.sum())
     dip = ar.pressure_shape(c, p, np.zeros_like(p), heap_half=half)
     assert dip["shape"] == "dip" and dip["resolved"]
-    peak = ar.pressure_shape(c, p[::-1].copy(), np.zeros_like(p), heap_half=half)
-    assert peak["shape"] == "maximum"
+    peaked = np.array([5.0, 3.0, 1.0, 0.0, 0.0])
+    peak = ar.pressure_shape(c, peaked, np.full(5, 0.1), heap_half=half)
+    assert peak["shape"] == "maximum" and peak["resolved"]
+    assert peak["difference_Pa"] == pytest.approx(-2.0)
     noisy = ar.pressure_shape(c, p, np.full_like(p, 10 * p.max()), heap_half=half)
     assert not noisy["resolved"]
 
