@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the order of the tables: the papers' order (docs/cases.md)
 ORDER = ("nine_disc", "photoelastic", "biaxial", "elastic_gravity", "uniaxial_compression",
          "wave_bar", "soil_cutting", "contact_burst", "water_blocks", "plate_loading",
-         "ellipsoid_compression", "impact_benchmarks")
+         "ellipsoid_compression", "impact_benchmarks", "angle_of_repose")
 #: a few words on each case for the overview table
 WHAT = {
     "nine_disc": "nine discs compressed by four walls (Cundall & Strack)",
@@ -46,6 +46,7 @@ WHAT = {
     "plate_loading": "a plate pressed into beds of circles and superellipses (Miyata et al.)",
     "ellipsoid_compression": "ellipsoids under a plate: forces on the plates (Miyata et al.)",
     "impact_benchmarks": "sphere impacts against Hertz and Coulomb theory (Chung & Ooi)",
+    "angle_of_repose": "heaps of cubes beside heaps of spheres: angle of repose (Chen)",
 }
 
 

@@ -1,0 +1,128 @@
+"""The angle_of_repose case (cases/angle_of_repose.py): the profile fit against synthetic
+heaps of known angle, the pressure profile and its shape against hand-made forces, and
+small poured heaps of cubes and of spheres: at rest, their weight on the base, small
+overlaps, an angle on both flanks, and a summary that follows the schema."""
+import math
+
+import numpy as np
+import pytest
+
+from cases import _common as common
+from cases import angle_of_repose as ar
+
+D = ar.D
+
+
+@pytest.mark.parametrize("angle", [20.0, 33.0, 45.0])
+def test_fit_recovers_a_synthetic_triangular_heap(angle):
+    x, z = ar.synthetic_cone(angle, 14.0 * D, ar.BIN * D, seed=3)
+    c, h = ar.profile(x, z, ar.BIN * D)
+    fit = ar.fit_flanks(c, h)
+    for side in ("left", "right"):
+        assert fit[side]["angle"] == pytest.approx(angle, abs=0.1), side
+    assert fit["left"]["slope"] > 0 > fit["right"]["slope"]
+    assert abs(fit["apex_x"]) <= ar.BIN * D
+
+
+def test_fit_leaves_out_the_apex_cap_and_the_toe():
+    # a 30° heap with a flat cap (|x| < 3 d) and a long flat toe: the band fit sees
+    # only the flanks
+    c = (np.arange(-25, 25) + 0.5) * D
+    t = math.tan(math.radians(30.0))
+    h = np.clip(t * (15 * D - np.abs(c)), 0.4 * D, t * 12 * D)
+    fit = ar.fit_flanks(c, h)
+    for side in ("left", "right"):
+        assert fit[side]["angle"] == pytest.approx(30.0, abs=1e-9)
+    # a flank with fewer than three bins in the band gets no angle
+    short = ar.fit_flanks(np.array([-2.5, -1.5, -0.5, 0.5, 1.5]) * D,
+                          np.array([0.1, 0.5, 1.0, 0.5, 0.1]) * D)
+    assert short["left"]["angle"] is None and short["right"]["angle"] is None
+
+
+def test_profile_takes_the_highest_top_of_each_bin():
+    x = np.array([0.1, 0.2, 0.9, 1.5, 1.6]) * D
+    tops = np.array([1.0, 3.0, 2.0, 0.5, 0.7]) * D
+    c, h = ar.profile(x, tops, D, base=0.5 * D)
+    assert np.allclose(c, [0.5 * D, 1.5 * D])
+    assert np.allclose(h, [2.5 * D, 0.2 * D])
+
+
+def test_pressure_profile_and_its_shape():
+    w, half = 6.5 * D, 10 * D
+    x = np.array([-0.5, 0.5, 2.5, -2.5, 5.0]) * D
+    f = np.array([1.0, 1.0, 3.0, 1.0, 2.0])
+    c, p = ar.pressure_profile(x, f, 0.0, half, w, bin_width=2 * D)
+    area = 2 * 2 * D * w
+    assert np.allclose(p[:3], np.array([2.0, 4.0, 2.0]) / area)
+    assert np.sum(p * area) == pytest.approx(f.sum())
+    dip = ar.pressure_shape(c, p, np.zeros_like(p), heap_half=half)
+    assert dip["shape"] == "dip" and dip["resolved"]
+    peaked = np.array([5.0, 3.0, 1.0, 0.0, 0.0])
+    peak = ar.pressure_shape(c, peaked, np.full(5, 0.1), heap_half=half)
+    assert peak["shape"] == "maximum" and peak["resolved"]
+    assert peak["difference_Pa"] == pytest.approx(-2.0)
+    noisy = ar.pressure_shape(c, p, np.full_like(p, 10 * p.max()), heap_half=half)
+    assert not noisy["resolved"]
+
+
+def test_cube_top_is_its_highest_vertex():
+    m = ar.Model("cubes")
+    # a cube turned 45° about x: its top is half a face diagonal above the centre
+    a = math.radians(45.0)
+    q = np.array([[math.cos(a / 2), math.sin(a / 2), 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]])
+    p = {"position": np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 2.0]]), "orientation": q}
+    assert np.allclose(m.tops(p), [1.0 + D / math.sqrt(2.0), 2.0 + 0.5 * D])
+    s = ar.Model("spheres")
+    assert s.radius ** 3 * 4 * math.pi / 3 == pytest.approx(D ** 3)
+
+
+@pytest.fixture(scope="module")
+def heaps():
+    """Small wedge heaps (150 grains) of cubes and of spheres, one seed each."""
+    cfg = dict(ar.PRESETS["quick"], particles=150, half_base=14.0, settle_max=1.0)
+    import os
+    opts = {"threads": int(os.environ.get("TDEM_THREADS", "1"))}
+    out = {}
+    for name in ("cubes", "spheres"):
+        r, heap = ar.run_heap(ar.Model(name), "wedge", cfg, opts, seed=1, log=lambda s: None)
+        out[name] = r
+    return out
+
+
+def test_small_heaps_rest_on_the_base_and_carry_their_weight(heaps):
+    for name, r in heaps.items():
+        assert r["kinetic_ratio"] < ar.REST, name
+        assert r["balance"] == pytest.approx(1.0, abs=0.01), name
+        assert r["grains"] + r["fallen"] == 150
+        assert r["fallen"] <= 5
+        # small overlaps: the angle does not depend on E
+        assert r["overlap_mean"] < 0.01 and r["overlap_max"] < 0.05, name
+        assert 0.45 < r["packing"] < 0.8, name
+
+
+def test_small_heaps_have_an_angle_on_both_flanks(heaps):
+    for name, r in heaps.items():
+        for side in ("left", "right"):
+            a = r["fit"][side]["angle"]
+            assert a is not None and 5.0 < a < 60.0, (name, side, a)
+
+
+def test_summary_schema_of_a_finished_run(heaps, tmp_path):
+    # the summary of three "seeds" made of the same two heaps (the analysis, not the
+    # statistics, is under test): it follows the schema
+    runs = {("cubes", "wedge"): [heaps["cubes"]] * 3,
+            ("spheres", "wedge"): [heaps["spheres"]] * 3,
+            ("cubes", "layered"): [heaps["cubes"]] * 3}
+
+    class Args:
+        preset, threads = "quick", 1
+
+    s = ar.finish(Args, tmp_path, ar.PRESETS["quick"], runs, common.Stopwatch())
+    assert common.validate(s) == []
+    c = common.checks_by_name(s)
+    assert c["fit.synthetic_heap_error"]["pass"] is True
+    assert c["heaps.base_carries_weight"]["pass"] is True
+    assert c["cubes.angle"]["value"] == pytest.approx(heaps["cubes"]["angle"])
+    for png in ("heap_profiles.png", "base_pressure.png", "angles.png"):
+        assert (tmp_path / png).stat().st_size > 0
+
