@@ -363,3 +363,29 @@ def test_sphere_rests_on_a_cube_at_the_cap_volume_balance():
     c = sim.contacts.numpy()
     assert c["volume"][0] == pytest.approx(math.pi * u * u * (3 * r - u) / 3.0, rel=0.03)
     assert np.allclose(c["point"][0][:2], [0.01, 0.005], atol=1e-9)
+
+
+@pytest.mark.parametrize("theta", [20.0, 35.0])
+def test_cube_on_a_fixed_cube_sticks_or_slides_by_coulomb(theta):
+    """Two cubes face to face (the pair's overlap polyhedron, not a wall), the lower one
+    held, gravity tilted by θ: below atan μ the upper one stays, above it slides at
+    g(sin θ − μ cos θ)."""
+    th = math.radians(theta)
+    g = 9.81
+    sim, law = cube_sim(friction=0.5, restitution=0.3,
+                        gravity=(g * math.sin(th), 0.0, -g * math.cos(th)))
+    big = tdem.Polyhedron.box(1.0, 0.4, L)
+    sim.add_particles([[0.0, 0.0, -L / 2]], shape=big, density=RHO, contact=law)
+    sim.fix_particles([0], vx=0.0, vy=0.0, vz=0.0, omega=(0.0, 0.0, 0.0))
+    sim.add_particles([[-0.3, 0.0, L / 2 - 1e-6]], shape=tdem.Polyhedron.cube(L), density=RHO,
+                      contact=law)
+    sim.monitor("x", lambda s: [s.time, s.particles.numpy()["velocity"][1, 0],
+                                s.particles.numpy()["position"][1, 0]], every=10)
+    sim.run(until=0.3)
+    h = np.asarray(sim.histories()["x"][1])
+    late = h[:, 0] > 0.1
+    if theta < math.degrees(math.atan(0.5)):
+        assert np.ptp(h[late, 2]) < 1e-4
+    else:
+        a = np.polyfit(h[late, 0], h[late, 1], 1)[0]
+        assert a == pytest.approx(g * (math.sin(th) - 0.5 * math.cos(th)), rel=0.03)
