@@ -29,8 +29,12 @@ simple cubic lattice, 37 × 37 × 15 = 20,535 of them, in the same box under gra
 a settled bed where every inner cube has six face contacts (the heaviest contact of
 the overlap-volume law: a full overlap polyhedron per face), with
 ``tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5)``; the same steps.
-``--yade`` runs the same bed in Yade's Polyhedra (``yade-batch``-free: ``yade -n -x``)
-on one thread and prints its rate beside tdem's.
+``--yade`` runs the same bed in Yade's Polyhedra (``yade -n -x -j 1``: one thread,
+the floor as two facets) and prints its rate beside tdem's; ``--scale`` shrinks the
+bed for both (Yade takes minutes per hundred steps of the full one). Exactly parallel
+faces are a degenerate case for Yade's intersection (it warns and misses contacts on
+the stacked lattice); ``--settled`` gives both codes a bed of randomly oriented cubes
+settled under gravity (by tdem, cached in ``benchmarks/out/``).
 """
 import argparse
 import json
@@ -71,21 +75,58 @@ def cube_lattice(w=0.12, layers=15):
     return g.reshape(-1, 3)
 
 
-def build_cubes(arch=None, threads=None):
+def settled_cubes(scale, seed=0, seconds=0.35, threads=None):
+    """A bed of randomly oriented cubes settled under gravity in tdem (no parallel
+    faces: a fair bed for Yade's CGAL intersections): (centres, quaternions), cached
+    in benchmarks/out/."""
     import tdem
+    w = 0.12 * math.sqrt(scale)
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out",
+                        f"cubes_settled_{scale:g}_{seed}.npz")
+    if os.path.exists(path):
+        d = np.load(path)
+        return d["x"], d["q"]
+    a = 1.8 * EDGE
+    k = int(w // a)
+    layers = int(round(len(cube_lattice(w)) / (k * k)))
+    off = 0.5 * (w - k * a) + 0.5 * a
+    g = np.stack(np.meshgrid(off + a * np.arange(k), off + a * np.arange(k),
+                             0.5 * a + a * np.arange(layers), indexing="ij"), -1).reshape(-1, 3)
+    vol = tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5)
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=1e-5, local_damping=0.3,
+                          progress=True, threads=threads)
+    sim.add_particles(g, shape=tdem.Polyhedron.cube(EDGE), density=2500.0, contact=vol,
+                      orientation=tdem.random_orientations(len(g), seed=seed))
+    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w, layers * a + 0.01))
+    sim.add_mesh(verts, tris, contact=vol)
+    sim.run(until=seconds)
+    s = sim.particles.numpy()
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    np.savez(path, x=s["position"], q=s["orientation"])
+    return s["position"], s["orientation"]
+
+
+def build_cubes(arch=None, threads=None, scale=1.0, bed=None):
+    import tdem
+    w = 0.12 * math.sqrt(scale)
     vol = tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5)
     sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=1e-5, arch=arch,
                           threads=threads, skin=0.0004, check_interval=500, progress=False)
-    sim.add_particles(cube_lattice(), shape=tdem.Polyhedron.cube(EDGE), density=2500.0,
-                      contact=vol)
-    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (0.12, 0.12, 0.2))
+    if bed is None:
+        sim.add_particles(cube_lattice(w), shape=tdem.Polyhedron.cube(EDGE), density=2500.0,
+                          contact=vol)
+    else:
+        sim.add_particles(bed[0], shape=tdem.Polyhedron.cube(EDGE), density=2500.0,
+                          contact=vol, orientation=bed[1])
+    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w, 0.2))
     sim.add_mesh(verts, tris, contact=vol)
     return sim
 
 
 YADE_SCRIPT = """
 import time, numpy as np
-from yade import polyhedra_utils
+from yade import polyhedra_utils, log
+log.setDefaultLogLevel(log.ERROR)     # (its intersection warns per contact otherwise)
 O.engines = [ForceResetter(),
   InsertionSortCollider([Bo1_Polyhedra_Aabb(), Bo1_Facet_Aabb()], verletDist=0.0004),
   InteractionLoop([Ig2_Polyhedra_Polyhedra_PolyhedraGeom(), Ig2_Facet_Polyhedra_PolyhedraGeom()],
@@ -96,15 +137,17 @@ mat = PolyhedraMat(density=2500, young=1e7, poisson=0.3, frictionAngle=0.4636)
 O.materials.append(mat)
 e = {edge!r}
 cube = [(x, y, z) for x in (-e/2, e/2) for y in (-e/2, e/2) for z in (-e/2, e/2)]
-for c in {centres!r}:
+for c, q in zip({centres!r}, {orientations!r}):
     b = polyhedra_utils.polyhedra(mat, v=cube, fixed=False)
     b.state.pos = c
+    b.state.ori = Quaternion(*q) * b.state.ori
     O.bodies.append(b)
-w = 0.12
+w = {width!r}
 for f in [((0,0,0),(w,0,0),(w,w,0)), ((0,0,0),(w,w,0),(0,w,0))]:
     O.bodies.append(facet(f, material=mat, fixed=True))
 O.dt = 1e-5
 O.run({warmup}, True)
+print("interactions", len([i for i in O.interactions if i.isReal]))
 t = time.time()
 O.run({steps}, True)
 el = time.time() - t
@@ -112,19 +155,26 @@ print("PEER yade-polyhedra 1 particle_steps_per_s %.0f" % (len(O.bodies) * {step
 """
 
 
-def run_yade(steps, warmup):
-    """Yade's Polyhedra on the cube bed (one thread): its particle-steps per second."""
+def run_yade(steps, warmup, scale=1.0, bed=None):
+    """Yade's Polyhedra on the cube bed (one thread; a floor, no side walls): its
+    particle-steps per second, its contacts after the warm-up and its warnings."""
     import tempfile
-    script = YADE_SCRIPT.format(edge=EDGE, centres=[tuple(map(float, c)) for c in cube_lattice()],
-                                warmup=warmup, steps=steps)
+    w = 0.12 * math.sqrt(scale)
+    x, q = bed if bed is not None else (cube_lattice(w), np.tile([1.0, 0, 0, 0], (len(
+        cube_lattice(w)), 1)))
+    script = YADE_SCRIPT.format(edge=EDGE, width=w, warmup=warmup, steps=steps,
+                                centres=[tuple(map(float, c)) for c in x],
+                                orientations=[tuple(map(float, c)) for c in q])
     with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
         f.write(script)
     out = subprocess.run(["yade", "-n", "-x", "-j", "1", f.name], capture_output=True,
                          text=True)
-    lines = [ln for ln in (out.stdout + out.stderr).splitlines() if ln.startswith("PEER")]
-    if not lines:
+    text = out.stdout + out.stderr
+    lines = [ln for ln in text.splitlines() if ln.startswith(("PEER", "interactions"))]
+    if not any(ln.startswith("PEER") for ln in lines):
         raise RuntimeError("yade gave no rate:\n" + out.stdout[-2000:] + out.stderr[-2000:])
-    return lines[-1]
+    warned = sum(1 for ln in text.splitlines() if "WARN" in ln)
+    return "\n".join(lines) + f"\nyade warnings {warned}"
 
 
 def build(scale=1.0, arch=None, threads=None, ellipsoids=False):
@@ -146,8 +196,9 @@ def build(scale=1.0, arch=None, threads=None, ellipsoids=False):
     return sim
 
 
-def measure(scale, steps, warmup, arch, threads, ellipsoids=False, cubes=False):
-    sim = build_cubes(arch, threads) if cubes else build(scale, arch, threads, ellipsoids)
+def measure(scale, steps, warmup, arch, threads, ellipsoids=False, cubes=False, bed=None):
+    sim = (build_cubes(arch, threads, scale, bed) if cubes else
+           build(scale, arch, threads, ellipsoids))
     sim.run(steps=warmup)
     t = time.perf_counter()
     sim.run(steps=steps)
@@ -173,6 +224,9 @@ def main(argv=None):
                    help="about 20,000 cubes stacked face to face (tdem.VolumeContact)")
     p.add_argument("--yade", action="store_true",
                    help="with --cubes: also Yade's Polyhedra on the same bed")
+    p.add_argument("--settled", action="store_true",
+                   help="with --cubes: randomly oriented cubes settled under gravity first "
+                        "(in tdem, cached in benchmarks/out/) instead of the stacked lattice")
     p.add_argument("--json", default=None, help="append the results to this JSON file")
     args = p.parse_args(argv)
     if args.scaling:
@@ -185,8 +239,11 @@ def main(argv=None):
                   [ln for ln in out.splitlines() if ln.startswith("PEER")][-1], flush=True)
         return
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+    bed = settled_cubes(args.scale, threads=args.threads) if args.cubes and args.settled else None
     sim, rate, el = measure(args.scale, args.steps, args.warmup, args.arch, args.threads,
-                            args.ellipsoids, args.cubes)
+                            args.ellipsoids, args.cubes, bed)
+    if args.cubes:
+        print(f"contacts {len(sim.contacts.numpy()['pairs'])}")
     s = sim.particles.numpy()
     print(f"particles {sim.n_particles} steps {args.steps} seconds {el:.3f} "
           f"zmax {s['position'][:, 2].max() + 0.002:.5f} vz {s['velocity'][:, 2].mean():.3e}")
@@ -195,7 +252,7 @@ def main(argv=None):
     tag = "-ellipsoids" if args.ellipsoids else "-cubes" if args.cubes else ""
     print(f"PEER tdem{tag} {args.threads} particle_steps_per_s {rate:.0f}", flush=True)
     if args.cubes and args.yade:
-        print(run_yade(args.steps, args.warmup), flush=True)
+        print(run_yade(args.steps, args.warmup, args.scale, bed), flush=True)
     if args.json:
         rec = {"particles": sim.n_particles, "threads": args.threads, "steps": args.steps,
                "seconds": el, "particle_steps_per_s": rate, "arch": args.arch or "cpu"}
