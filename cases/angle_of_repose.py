@@ -104,6 +104,7 @@ from pathlib import Path
 import numpy as np
 
 import tdem
+from physics.shapes import quaternion_rotations as rotations
 
 from . import _common as common
 
@@ -185,17 +186,6 @@ class Model:
         r = rotations(p["orientation"])
         vz = np.einsum("nk,vk->nv", r[:, 2, :], self.shape.vertices)
         return z + vz.max(axis=1)
-
-
-def rotations(q):
-    """(N, 3, 3) body-to-world rotation matrices of unit quaternions (w, x, y, z)."""
-    q = np.asarray(q, dtype=float).reshape(-1, 4)
-    w, x, y, z = q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], 1)
 
 
 # ------------------------------------------------------------------ the base

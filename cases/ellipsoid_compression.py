@@ -131,6 +131,7 @@ import time
 import numpy as np
 
 import tdem
+from physics.shapes import quaternion_rotations as rotations
 
 from . import _common as common
 
@@ -236,17 +237,6 @@ def ks_distance(f, pdf):
 
 
 # ------------------------------------------------------------------ geometry
-def rotations(q):
-    """(N, 3, 3) body-to-world rotation matrices of unit quaternions (w, x, y, z)."""
-    q = np.asarray(q, dtype=float).reshape(-1, 4)
-    w, x, y, z = q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], 1)
-
-
 def half_height(q, axes=SEMI_AXES):
     """How far each ellipsoid reaches above (and below) its centre: sqrt(e_zᵀ M e_z),
     M = R diag(a², b², c²) Rᵀ."""

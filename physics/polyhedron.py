@@ -23,6 +23,7 @@ import numpy as np
 
 from tdem.errors import InputError
 
+from .shapes import quaternion_rotations
 from .validate import positive
 
 MAX_VERTICES = 32
@@ -188,7 +189,7 @@ class Polyhedron:
             return self.vertices.copy(), self.triangles.copy()
         x = np.asarray(centres, float).reshape(-1, 3)
         q = np.asarray(orientations, float).reshape(-1, 4)
-        rot = rotations(q)
+        rot = quaternion_rotations(q)
         pts = x[:, None, :] + np.einsum("nij,vj->nvi", rot, self.vertices)
         nv = len(self.vertices)
         tri = (self.triangles[None, :, :] + nv * np.arange(len(x))[:, None, None])
@@ -343,11 +344,3 @@ def _mass_properties(p, tris):
     inertia = np.trace(cov) * np.eye(3) - cov
     return vol, o + centroid, inertia
 
-
-def rotations(q):
-    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) (w, x, y, z)."""
-    w, x, y, z = (np.asarray(q, dtype=float)[:, k] for k in range(4))
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], 1)

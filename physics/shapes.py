@@ -133,6 +133,17 @@ def rotation(theta):
     return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
 
 
+def quaternion_rotations(q):
+    """(N, 3, 3) body-to-world rotation matrices of unit quaternions q (N, 4), (w, x, y, z)."""
+    q = np.asarray(q, dtype=float).reshape(-1, 4)
+    w, x, y, z = q.T
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], 1)
+
+
 def support_depth(si, xi, ti, sj, xj, tj, m=4096):
     """Penetration depth of two shapes by a scan of the normal angle at ``m`` angles,
     refined around the best by Brent's method (a reference for tests, independent of

@@ -102,6 +102,13 @@ def wall_offset(wall: ti.template(), w, x):
 
 
 @ti.func
+def tri_vec(wall: ti.template(), w, c: ti.template()):
+    """Columns c, c + 1, c + 2 of row w of the wall table (a corner, velocity, ... of a
+    mesh triangle) as a 3-vector."""
+    return ti.Vector([wall[w, c], wall[w, c + 1], wall[w, c + 2]])
+
+
+@ti.func
 def slot_bits(cap):
     """log2 of the slot capacity (always a power of two): a reverse-list entry packs
     (owner j, slot k) as j << bits | k."""

@@ -30,7 +30,8 @@ from physics.geometry.ellipsoid import rotation
 from physics.geometry.frame import moment, tangent_part
 from physics.polyhedron import PI_TRIS, PT_LENGTH, PT_NE, PT_NF, PT_NT, PT_PLANES, PT_VERTS
 
-from .neighbors import F_NONCONV, T_AX, T_BX, T_CX, T_LAW, T_OX, T_VX, T_WX, image
+from .neighbors import (F_NONCONV, T_AX, T_BX, T_CX, T_LAW, T_OX, T_VX, T_WX, image,
+                        tri_vec)
 from .state import PROP_MASS, PROP_RADIUS
 
 PI = 3.141592653589793
@@ -225,11 +226,6 @@ def poly_pair(i, k, xi, vi, wi, mi, li, pos: ti.template(), vel: ti.template(),
 
 
 @ti.func
-def _tri(wall: ti.template(), w, c: ti.template()):
-    return ti.Vector([wall[w, c], wall[w, c + 1], wall[w, c + 2]])
-
-
-@ti.func
 def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
                   prop: ti.template(), angle: ti.template(), shp: ti.template(),
                   wall: ti.template(), wforce: ti.template(), lawp: ti.template(),
@@ -259,9 +255,9 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         w = wid[i, s]
         if w < 0:
             break
-        a = _tri(wall, w, T_AX)
-        b = _tri(wall, w, T_BX)
-        c3 = _tri(wall, w, T_CX)
+        a = tri_vec(wall, w, T_AX)
+        b = tri_vec(wall, w, T_BX)
+        c3 = tri_vec(wall, w, T_CX)
         nf = (b - a).cross(c3 - a).normalized()
         if (xi - a).dot(nf) < 0.0:
             nf = -nf
@@ -279,8 +275,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         if status != 0 and vol > 0.0:
             n = -nf
             arm = cen - xi
-            o = _tri(wall, w, T_OX)
-            vw = _tri(wall, w, T_VX) + _tri(wall, w, T_WX).cross(cen - o)
+            o = tri_vec(wall, w, T_OX)
+            vw = tri_vec(wall, w, T_VX) + tri_vec(wall, w, T_WX).cross(cen - o)
             vrel = vw - vel[i] - omega[i].cross(arm)
             vn = vrel.dot(n)
             u = vol / l2

@@ -28,6 +28,7 @@ import taichi as ti
 
 from physics import contact_law as _claw
 from physics.shapes import mass_properties, principal_inertia
+from physics.shapes import quaternion_rotations as _rotations
 from physics.volume_contact import VolumeContact
 
 from . import backend, neighbors
@@ -48,40 +49,35 @@ ANNOUNCE_SECONDS = 30.0
 ANNOUNCE_MEASURE = 0.5
 
 
-def _rotations(q):
-    """Rotation matrices (n, 3, 3) of unit quaternions (n, 4) (w, x, y, z)."""
-    w, x, y, z = (np.asarray(q, dtype=float)[:, k] for k in range(4))
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], 1)
-
-
 class Runner:
     """Device state and the run loop of :class:`tdem.Simulation` (module docstring)."""
 
 
-    @property
-    def _has_shapes(self):
-        """Whether some particles are superellipses (the step kernel's ``shapes``)."""
+    def _shapes_present(self):
+        """(any shaped particle, the step kernel's ``shapes`` bits tdem.step.SHAPES_*),
+        worked out again only when particles were added."""
         chunks = self._host["shape"]
         if self._shaped_cache is None or self._shaped_cache[0] != len(chunks):
-            self._shaped_cache = (len(chunks), any(bool((c[:, 2] > 0).any()) for c in chunks))
-        return self._shaped_cache[1]
+            shaped = any(bool((c[:, 2] > 0).any()) for c in chunks)
+            code = 0
+            if shaped:
+                rows = np.concatenate(chunks)
+                if self.dim == 2 or (rows[:, 3] > 0).any():
+                    code |= stepk.SHAPES_SMOOTH
+                if self.dim == 3 and (rows[:, 3] < 0).any():
+                    code |= stepk.SHAPES_POLY
+            self._shaped_cache = (len(chunks), shaped, code)
+        return self._shaped_cache[1:]
+
+    @property
+    def _has_shapes(self):
+        """Whether some particles are superellipses, ellipsoids or polyhedra."""
+        return self._shapes_present()[0]
 
     @property
     def _shape_code(self):
-        """The step kernel's ``shapes`` bits (tdem.step.SHAPES_*): which shape code
-        it compiles."""
-        if not self._has_shapes:
-            return 0
-        rows = np.concatenate(self._host["shape"])
-        code = 0
-        if self.dim == 2 or (rows[:, 3] > 0).any():
-            code |= stepk.SHAPES_SMOOTH
-        if self.dim == 3 and (rows[:, 3] < 0).any():
-            code |= stepk.SHAPES_POLY
-        return code
+        """The step kernel's ``shapes`` bits: which shape code it compiles."""
+        return self._shapes_present()[1]
 
     def _upload_polyhedra(self):
         """The shape tables of the polyhedra (physics.polyhedron), one row each."""

@@ -30,7 +30,7 @@ from .launch import cached
 from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY,  # noqa: F401
                         P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0, P_PZ0, P_SKIN,
                         SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH, T_OX, T_VX, T_WX,
-                        TRI_WIDTH, gravity, image, periodic_axes, slot_bits)
+                        TRI_WIDTH, gravity, image, periodic_axes, slot_bits, tri_vec)
 from . import polyhedra3d, shaped3d
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
@@ -256,18 +256,13 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
 
 
 @ti.func
-def _tri(wall: ti.template(), w, c: ti.template()):
-    return ti.Vector([wall[w, c], wall[w, c + 1], wall[w, c + 2]])
-
-
-@ti.func
 def _mesh_geometry(xi, ri, shaped, mat, abc, wall: ti.template(), w):
     """(touching, depth, n from the particle to the wall, contact point, feature,
     Hertz radius) of a sphere (radius ri) or an ellipsoid (``shaped``: shape matrix
     ``mat``, semi-axes ``abc``) against mesh triangle w."""
-    a = _tri(wall, w, T_AX)
-    b = _tri(wall, w, T_BX)
-    c = _tri(wall, w, T_CX)
+    a = tri_vec(wall, w, T_AX)
+    b = tri_vec(wall, w, T_BX)
+    c = tri_vec(wall, w, T_CX)
     depth = 0.0
     n = ti.Vector([0.0, 0.0, -1.0])
     point = xi
@@ -356,8 +351,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                                 h = h2
                                 whist[i, s2] = zero_history(h2)
             arm = point - xi
-            c = _tri(wall, w, T_OX)
-            vw = _tri(wall, w, T_VX) + spin_cross(_tri(wall, w, T_WX), point - c)
+            c = tri_vec(wall, w, T_OX)
+            vw = tri_vec(wall, w, T_VX) + spin_cross(tri_vec(wall, w, T_WX), point - c)
             vrel = vw - vel[i] - spin_cross(omega[i], arm)
             vn = vrel.dot(n)
             L = ti.cast(wall[w, T_LAW], ti.i32)
@@ -370,7 +365,7 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             if ti.static(h.n >= RW + 7):
                 # rolling resistance against the wall (r̄ = 2 R_i, Jiang Eq. 11b)
                 m, m_roll, th, brk, d2 = rolling_couple_3d(
-                    lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - _tri(wall, w, T_WX), n, dt,
+                    lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - tri_vec(wall, w, T_WX), n, dt,
                     get_columns(h, RW, 3), get_columns(h, RW + 3, 3), h[RW + 6])
                 h = put_columns(h, RW, m)
                 h = put_columns(h, RW + 3, th)
@@ -597,11 +592,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     fw, mw, dw, work = polyhedra3d.mesh_contacts(
                         i, pos, vel, omega, prop, angle, shp, wall, wforce, lawp, wid, whist,
                         wcn, wcf, wcs, flags, dt, laws, ptab, pint)
-                else:
-                    fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce,
-                                                     lawp, wid, whist, wcn, wcf, wcs, dt, laws,
-                                                     ishaped, mati, shi)
-            else:
+            if not ipoly:
                 fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce, lawp,
                                                  wid, whist, wcn, wcf, wcs, dt, laws, ishaped,
                                                  mati, shi)
@@ -802,14 +793,14 @@ def move_triangle(wall: ti.template(), w, dt, skin, flags: ti.template()):
     v Δt; one that has moved half the skin since the lists were built asks for a
     rebuild."""
     if True:
-        v = _tri(wall, w, T_VX)
-        om = _tri(wall, w, T_WX)
-        c = _tri(wall, w, T_OX)
+        v = tri_vec(wall, w, T_VX)
+        om = tri_vec(wall, w, T_WX)
+        c = tri_vec(wall, w, T_OX)
         if v.dot(v) > 0.0 or om.dot(om) > 0.0:
             rot = rotation_matrix(om * dt)
             arm = 0.0
             for corner in ti.static((T_AX, T_BX, T_CX)):
-                p = _tri(wall, w, corner)
+                p = tri_vec(wall, w, corner)
                 arm = ti.max(arm, (p - c).norm())
                 p = c + v * dt + rot @ (p - c)
                 for k in ti.static(range(3)):
