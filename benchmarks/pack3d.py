@@ -75,6 +75,18 @@ def cube_lattice(w=0.12, layers=15):
     return g.reshape(-1, 3)
 
 
+def loose_cubes(w):
+    """Centres of the cubes' loose lattice (1.8 edges apart, as many as the stacked
+    bed of box width w) and the height of the box that holds it."""
+    a = 1.8 * EDGE
+    k = int(w // a)
+    layers = int(round(len(cube_lattice(w)) / (k * k)))
+    off = 0.5 * (w - k * a) + 0.5 * a
+    g = np.stack(np.meshgrid(off + a * np.arange(k), off + a * np.arange(k),
+                             0.5 * a + a * np.arange(layers), indexing="ij"), -1).reshape(-1, 3)
+    return g, layers * a + 0.01
+
+
 def settled_cubes(scale, seed=0, seconds=0.35, threads=None):
     """A bed of randomly oriented cubes settled under gravity in tdem (no parallel
     faces: a fair bed for Yade's CGAL intersections): (centres, quaternions), cached
@@ -86,18 +98,13 @@ def settled_cubes(scale, seed=0, seconds=0.35, threads=None):
     if os.path.exists(path):
         d = np.load(path)
         return d["x"], d["q"]
-    a = 1.8 * EDGE
-    k = int(w // a)
-    layers = int(round(len(cube_lattice(w)) / (k * k)))
-    off = 0.5 * (w - k * a) + 0.5 * a
-    g = np.stack(np.meshgrid(off + a * np.arange(k), off + a * np.arange(k),
-                             0.5 * a + a * np.arange(layers), indexing="ij"), -1).reshape(-1, 3)
+    g, height = loose_cubes(w)
     vol = tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5)
     sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=1e-5, local_damping=0.3,
                           progress=True, threads=threads)
     sim.add_particles(g, shape=tdem.Polyhedron.cube(EDGE), density=2500.0, contact=vol,
                       orientation=tdem.random_orientations(len(g), seed=seed))
-    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w, layers * a + 0.01))
+    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w, height))
     sim.add_mesh(verts, tris, contact=vol)
     sim.run(until=seconds)
     s = sim.particles.numpy()
@@ -106,19 +113,27 @@ def settled_cubes(scale, seed=0, seconds=0.35, threads=None):
     return s["position"], s["orientation"]
 
 
-def build_cubes(arch=None, threads=None, scale=1.0, bed=None):
+def build_cubes(arch=None, threads=None, scale=1.0, bed=None, broad_phase="grid"):
     import tdem
     w = 0.12 * math.sqrt(scale)
     vol = tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5)
     sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=1e-5, arch=arch,
-                          threads=threads, skin=0.0004, check_interval=500, progress=False)
-    if bed is None:
+                          threads=threads, skin=0.0004, check_interval=500, progress=False,
+                          broad_phase=broad_phase)
+    height = 0.2
+    if bed == "pour":
+        # the loose lattice the settled bed starts from (random orientations), falling:
+        # a flow, the lists rebuilt every few steps
+        g, height = loose_cubes(w)
+        sim.add_particles(g, shape=tdem.Polyhedron.cube(EDGE), density=2500.0, contact=vol,
+                          orientation=tdem.random_orientations(len(g), seed=0))
+    elif bed is None:
         sim.add_particles(cube_lattice(w), shape=tdem.Polyhedron.cube(EDGE), density=2500.0,
                           contact=vol)
     else:
         sim.add_particles(bed[0], shape=tdem.Polyhedron.cube(EDGE), density=2500.0,
                           contact=vol, orientation=bed[1])
-    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w, 0.2))
+    verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w, height))
     sim.add_mesh(verts, tris, contact=vol)
     return sim
 
@@ -177,14 +192,15 @@ def run_yade(steps, warmup, scale=1.0, bed=None):
     return "\n".join(lines) + f"\nyade warnings {warned}"
 
 
-def build(scale=1.0, arch=None, threads=None, ellipsoids=False):
+def build(scale=1.0, arch=None, threads=None, ellipsoids=False, broad_phase="grid"):
     """The workload; ``scale`` widens the box in x and y (the scaling runs)."""
     import tdem
     w = 0.12 * math.sqrt(scale)
     pts = fcc(hi=(w - 0.002, w - 0.002, 0.158))
     hm = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.5, restitution=0.5)
     sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=1e-5, arch=arch,
-                          threads=threads, skin=0.0004, check_interval=500, progress=False)
+                          threads=threads, skin=0.0004, check_interval=500, progress=False,
+                          broad_phase=broad_phase)
     stretch = np.array([1.0, 0.8, 0.6]) if ellipsoids else np.ones(3)
     if ellipsoids:
         sim.add_particles(pts * stretch, shape=tdem.Ellipsoid(*(0.002 * stretch)),
@@ -196,14 +212,45 @@ def build(scale=1.0, arch=None, threads=None, ellipsoids=False):
     return sim
 
 
-def measure(scale, steps, warmup, arch, threads, ellipsoids=False, cubes=False, bed=None):
-    sim = (build_cubes(arch, threads, scale, bed) if cubes else
-           build(scale, arch, threads, ellipsoids))
+class BuildClock:
+    """Wall time of the neighbour-list builds (either broad phase's kernel) while on;
+    on the CPU a kernel call returns when it is done, and the host calls the build
+    only when the lists need it."""
+
+    def __init__(self):
+        import tdem.neighbors
+        import tdem.sweep
+        self.builds, self.seconds, self.on = 0, 0.0, False
+        for mod in (tdem.neighbors, tdem.sweep):
+            mod.rebuild = self._wrap(mod.rebuild)
+
+    def _wrap(self, kernel):
+        def timed(*args):
+            if not self.on:
+                return kernel(*args)
+            t = time.perf_counter()
+            out = kernel(*args)
+            self.seconds += time.perf_counter() - t
+            self.builds += 1
+            return out
+        # (the engine binds a kernel's arguments by the names it declares)
+        timed._primal = getattr(kernel, "_primal", None) or kernel.kernel._primal
+        return timed
+
+
+def measure(scale, steps, warmup, arch, threads, ellipsoids=False, cubes=False, bed=None,
+            broad_phase="grid", clock=None):
+    sim = (build_cubes(arch, threads, scale, bed, broad_phase) if cubes else
+           build(scale, arch, threads, ellipsoids, broad_phase))
     sim.run(steps=warmup)
+    if clock is not None:
+        clock.on = True
     t = time.perf_counter()
     sim.run(steps=steps)
     sim.particles.numpy()  # waits for the device
     el = time.perf_counter() - t
+    if clock is not None:
+        clock.on = False
     return sim, sim.n_particles * steps / el, el
 
 
@@ -227,6 +274,12 @@ def main(argv=None):
     p.add_argument("--settled", action="store_true",
                    help="with --cubes: randomly oriented cubes settled under gravity first "
                         "(in tdem, cached in benchmarks/out/) instead of the stacked lattice")
+    p.add_argument("--pour", action="store_true",
+                   help="with --cubes: the cubes falling from a loose lattice (a flow: the "
+                        "lists rebuilt every few steps) instead of a settled bed")
+    p.add_argument("--broad-phase", default="grid", choices=("grid", "sweep"),
+                   help="the neighbour search (tdem.Simulation(broad_phase=)); the time "
+                        "its list builds take is printed")
     p.add_argument("--json", default=None, help="append the results to this JSON file")
     args = p.parse_args(argv)
     if args.scaling:
@@ -240,8 +293,11 @@ def main(argv=None):
         return
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
     bed = settled_cubes(args.scale, threads=args.threads) if args.cubes and args.settled else None
+    if args.cubes and args.pour:
+        bed = "pour"
+    clock = BuildClock() if (args.arch or "cpu") == "cpu" else None
     sim, rate, el = measure(args.scale, args.steps, args.warmup, args.arch, args.threads,
-                            args.ellipsoids, args.cubes, bed)
+                            args.ellipsoids, args.cubes, bed, args.broad_phase, clock)
     if args.cubes:
         print(f"contacts {len(sim.contacts.numpy()['pairs'])}")
     s = sim.particles.numpy()
@@ -249,12 +305,17 @@ def main(argv=None):
           f"zmax {s['position'][:, 2].max() + 0.002:.5f} vz {s['velocity'][:, 2].mean():.3e}")
     if args.ellipsoids or args.cubes:
         print(f"nonconverged {sim.nonconverged_contacts}")
+    if clock is not None:
+        print(f"broad phase {args.broad_phase}: {clock.builds} list builds in the timed "
+              f"steps, {1e3 * clock.seconds / max(clock.builds, 1):.2f} ms each, "
+              f"{100 * clock.seconds / el:.1f} % of the time")
     tag = "-ellipsoids" if args.ellipsoids else "-cubes" if args.cubes else ""
     print(f"PEER tdem{tag} {args.threads} particle_steps_per_s {rate:.0f}", flush=True)
-    if args.cubes and args.yade:
+    if args.cubes and args.yade and bed != "pour":
         print(run_yade(args.steps, args.warmup, args.scale, bed), flush=True)
     if args.json:
         rec = {"particles": sim.n_particles, "threads": args.threads, "steps": args.steps,
+               "broad_phase": args.broad_phase,
                "seconds": el, "particle_steps_per_s": rate, "arch": args.arch or "cpu"}
         data = json.load(open(args.json)) if os.path.exists(args.json) else []
         data.append(rec)

@@ -78,6 +78,7 @@ def _config(sim):
         "continuum_capacity": int(sim._cont.capacity) if sim._cont is not None else 0,
         "periodic": [None if p is None else [float(p[0]), float(p[1])] for p in sim._periodic],
         "dim": int(sim.dim),
+        "broad_phase": sim.broad_phase,
         "meshes": [[int(a), int(b)] for a, b in sim._meshes],
         "polyhedra": [p.input_vertices.tolist() for p in getattr(sim, "_polys", [])],
         "account0": sim._account0,
@@ -534,7 +535,8 @@ def load(path, arch=None):
                      arch=arch, precision=cfg["precision"],
                      local_damping=cfg["local_damping"], global_damping=cfg["global_damping"],
                      skin=cfg["skin"], check_interval=cfg["check_interval"],
-                     progress=cfg["progress"], dim=cfg.get("dim", 2))
+                     progress=cfg["progress"], dim=cfg.get("dim", 2),
+                     broad_phase=cfg.get("broad_phase", "grid"))
     sim._dt_user = cfg["dt"]
     sim._laws = [ContactLaw.from_dict(d) for d in cfg["laws"]]
     sim._pair_override = {(a, b): c for a, b, c in cfg["pair_override"]}
@@ -627,3 +629,4 @@ def _restore_device(sim, state, cfg):
     for k in ("gridp", "gridn", "flags"):
         if k in state:
             sim._fill(k, state[k])
+    sim._sweep_stale()

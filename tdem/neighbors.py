@@ -44,7 +44,9 @@ F_NONCONV = 5    # shaped-particle contact evaluations whose iteration stopped s
 F_TBIN_NEED = 6  # 3D: entries the triangle bins needed (more than their capacity: the
                  # build looked at every triangle; the host grows the bins)
 F_TBIN_TOTAL = 7  # 3D: entries of the triangle bins at the last build
-FLAGS_SIZE = 8
+F_SWEEP = 8      # sort-and-sweep (tdem.sweep): 1 while its pair set matches its sorted
+                 # axes; 0 asks the next build to make the set again from the axes
+FLAGS_SIZE = 9
 
 # columns of the float parameter array ``simp`` (the step's and the search's)
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
@@ -150,6 +152,40 @@ def image(d, per):
     return d
 
 
+@ti.func
+def insert_partner(nbr: ti.template(), i, cnt, j):
+    """Partner j into particle i's half list of ``cnt`` partners, kept sorted by index
+    (nothing written past the capacity: the caller counts what was needed)."""
+    if cnt < nbr.shape[1]:
+        k = cnt
+        while k > 0 and nbr[i, k - 1] > j:
+            nbr[i, k] = nbr[i, k - 1]
+            k -= 1
+        nbr[i, k] = j
+
+
+@ti.func
+def close_half_list(i, cnt, nbr: ti.template(), ncnt: ti.template(), hist: ti.template(),
+                    nbr_old: ti.template(), ncnt_old: ti.template(),
+                    hist_old: ti.template()):
+    """Particle i's new half list of ``cnt`` partners closed: its length (at most the
+    capacity), each pair's history carried over from the old list (zero for a new
+    pair), the free slots cleared."""
+    cap = nbr.shape[1]
+    m = ti.min(cnt, cap)
+    ncnt[i] = m
+    for k in range(m):
+        j = nbr[i, k]
+        h = zero_history(hist[i, k])
+        for kk in range(ncnt_old[i]):
+            if nbr_old[i, kk] == j:
+                h = hist_old[i, kk]
+        hist[i, k] = h
+    for k in range(m, cap):
+        nbr[i, k] = -1
+        hist[i, k] = zero_history(hist[i, k])
+
+
 @cached
 @ti.kernel
 def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.ndarray(),
@@ -243,31 +279,34 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                                 cut = ri + prop[j][PROP_RADIUS] + skin
                                 if d.dot(d) < cut * cut:
                                     if j > i:
-                                        if cnt < cap:
-                                            # insertion into the sorted list
-                                            k = cnt
-                                            while k > 0 and nbr[i, k - 1] > j:
-                                                nbr[i, k] = nbr[i, k - 1]
-                                                k -= 1
-                                            nbr[i, k] = j
+                                        insert_partner(nbr, i, cnt, j)
                                         cnt += 1
                                     else:
                                         back += 1
             ti.atomic_max(flags[F_NEED], ti.max(cnt, back))
-            m = ti.min(cnt, cap)
-            ncnt[i] = m
-            for k in range(m):
-                j = nbr[i, k]
-                h = zero_history(hist[i, k])
-                for kk in range(ncnt_old[i]):
-                    if nbr_old[i, kk] == j:
-                        h = hist_old[i, kk]
-                hist[i, k] = h
-            for k in range(m, cap):
-                nbr[i, k] = -1
-                hist[i, k] = zero_history(hist[i, k])
+            close_half_list(i, cnt, nbr, ncnt, hist, nbr_old, ncnt_old, hist_old)
             xref[i] = xi
             rcnt[i] = 0
+    # 6.-8. reverse lists, the mesh triangles' bins, candidate walls
+    finish_build(pos, prop, nbr, ncnt, rev, rcnt, gridp, gridn, flags, wall, wid, whist,
+                 wid_old, whist_old, nwalls, skin, tbin_count, tbin_start, tbin_items, ncell,
+                 nx, nrows, dim)
+
+
+@ti.func
+def finish_build(pos: ti.template(), prop: ti.template(), nbr: ti.template(),
+                 ncnt: ti.template(), rev: ti.template(), rcnt: ti.template(),
+                 gridp: ti.template(), gridn: ti.template(), flags: ti.template(),
+                 wall: ti.template(), wid: ti.template(), whist: ti.template(),
+                 wid_old: ti.template(), whist_old: ti.template(), nwalls, skin,
+                 tbin_count: ti.template(), tbin_start: ti.template(),
+                 tbin_items: ti.template(), ncell, nx, nrows, dim: ti.template()):
+    """The part of a list build that follows the half lists, whichever broad phase made
+    them (this grid's or :mod:`tdem.sweep`): the reverse lists, the mesh triangles'
+    bins (3D), each particle's candidate walls; then the flag lowered. ``rcnt`` must
+    be zero on entry."""
+    n = pos.shape[0]
+    cap = nbr.shape[1]
     # 6. reverse lists (who names me), then sorted for a fixed summation order
     for j in range(n):
         if flags[F_REBUILD] != 0:
@@ -278,6 +317,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                     rev[i, r] = (j << slot_bits(cap)) | k
     for i in range(n):
         if flags[F_REBUILD] != 0:
+            ti.atomic_max(flags[F_NEED], rcnt[i])
             m = ti.min(rcnt[i], cap)
             rcnt[i] = m
             for a in range(1, m):
@@ -346,6 +386,8 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
         if flags[F_REBUILD] != 0:
             flags[F_BUILDS] += 1
             flags[F_REBUILD] = 0
+
+
 
 
 @ti.func

@@ -31,12 +31,12 @@ from physics.shapes import mass_properties, principal_inertia
 from physics.shapes import quaternion_rotations as _rotations
 from physics.volume_contact import VolumeContact
 
-from . import backend, neighbors
+from . import backend, neighbors, sweep
 from . import state as schema
 from . import step as stepk
 from .continuum import Continuum
 from .errors import CapacityError, InputError, InstabilityError
-from .neighbors import F_BAD, F_NEED, F_REBUILD, F_WALL_NEED, FLAGS_SIZE
+from .neighbors import F_BAD, F_NEED, F_REBUILD, F_SWEEP, F_WALL_NEED, FLAGS_SIZE
 
 
 MAX_SLOTS = 1024
@@ -118,7 +118,8 @@ class Runner:
                 "tbin_cap": 16 * nwalls + 1024 if self.dim == 3 else 1,
                 "wall_width": stepk.wall_width(self.dim), "laws_set": self._law_set,
                 "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes,
-                "rolling": self._rolling3d, "pshapes": max(len(self._polys), 1)}
+                "rolling": self._rolling3d, "pshapes": max(len(self._polys), 1),
+                "entries": 2 * n if self.broad_phase == "sweep" else 1}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
         return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
@@ -140,7 +141,9 @@ class Runner:
             self._host["pos"]) else np.zeros(n if self.dim == 2 else (n, 3)))
         s = self._new_rows(pos, vel, r, m, inertia, np.concatenate(self._host["law"]), shape,
                            np.concatenate(self._host["angle"]), om, self._cap, self._capw)
-        s["flags"] = np.array([1, 0, 0, n, 0, 0, 0, 0], np.int32)
+        s["flags"] = np.zeros(FLAGS_SIZE, np.int32)
+        s["flags"][F_REBUILD] = 1
+        s["flags"][F_BAD] = n
         return s
 
     def _new_rows(self, pos, vel, r, m, inertia, law, shape, angle, omega, cap, capw):
@@ -232,6 +235,28 @@ class Runner:
         self._apply_loads(initial=True)
         self._upload_params()
         self._a["flags"][F_REBUILD] = 1
+        self._start_sweep(state["pos"], state["prop"][:, 0])
+
+    def _start_sweep(self, pos, radius):
+        """Sort-and-sweep: the box ends of every axis in sorted order (the arrays are
+        new), and the pair set asked to be made again at the next build."""
+        if self.broad_phase != "sweep":
+            return
+        n = len(radius)
+        ends = np.empty((self.dim, 2 * n))
+        ends[:, 0::2] = (np.asarray(pos) - np.asarray(radius)[:, None]).T
+        ends[:, 1::2] = (np.asarray(pos) + np.asarray(radius)[:, None]).T
+        order = np.argsort(ends, axis=1, kind="stable").astype(np.int32)
+        self._a["sent"].from_numpy(order)
+        self._a["skey"].from_numpy(np.take_along_axis(ends, order, axis=1))
+        self._sweep_stale()
+
+    def _sweep_stale(self):
+        """Sort-and-sweep: the lists were put back (a snapshot, a checkpoint) or made
+        anew, and its box pairs were not: the next build makes them again from the
+        sorted axes (tdem.sweep, flags[F_SWEEP])."""
+        if self.broad_phase == "sweep":
+            self._a["flags"][F_SWEEP] = 0
 
     def _fill(self, k, v):
         arr = self._a[k]
@@ -548,6 +573,9 @@ class Runner:
 
     def _rebuild_args(self):
         self._sync_triangle_bins()
+        if self.broad_phase == "sweep":
+            return schema.bind(sweep.rebuild, self._a, nwalls=len(self._walls_host),
+                               skin=float(self.skin), dim=self.dim)
         return schema.bind(neighbors.rebuild, self._a, sorted_ids=self._a["sorted"],
                            nwalls=len(self._walls_host), skin=float(self.skin), dim=self.dim)
 
@@ -576,7 +604,7 @@ class Runner:
         # on a GPU the rebuild kernel runs every step and returns at once unless the
         # device raised the flag; on the CPU the host reads the flag (shared memory)
         if self._n and (not host_reads_flag or self._a["flags"][F_REBUILD] != 0):
-            neighbors.rebuild(*rebuild_args)
+            (sweep if self.broad_phase == "sweep" else neighbors).rebuild(*rebuild_args)
         if cont is not None:
             cont.pcmm_elements(self, dt, self._reach)
             cont.block_stresses(self, dt)
@@ -610,6 +638,7 @@ class Runner:
             self._cont.restore_snapshot()
         if self._n:
             schema.copy(self._snap, self._a, schema.dynamic(), self._serial())
+            self._sweep_stale()
         self._time, self._steps = self._snap_clock
         if self._steps == 0:
             self._account0 = None      # taken again after the replayed first step

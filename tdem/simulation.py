@@ -136,13 +136,21 @@ class Simulation(Runner, Results):
         are 3-vectors, orientations unit quaternions) and the walls triangle meshes
         (:meth:`add_mesh`); PCMM bodies, blocks, segment walls, superellipses and
         rolling resistance are 2D.
+    broad_phase : "grid" (a cell grid over bounding spheres, :mod:`tdem.neighbors`) or
+        "sweep" (incremental sort-and-sweep of bounding boxes, :mod:`tdem.sweep`; not
+        with periodic axes, PCMM bodies or blocks). Both list every pair within
+        R_i + R_j + skin and give the same forces; benchmarks/RESULTS.md says which
+        is faster where.
     """
 
     def __init__(self, gravity=None, dt=None, dt_fraction=0.2, arch=None,
                  precision="f64", local_damping=0.0, global_damping=0.0, skin=None,
-                 check_interval=100, progress=None, threads=None, dim=2):
+                 check_interval=100, progress=None, threads=None, dim=2, broad_phase="grid"):
         if dim not in (2, 3) or isinstance(dim, bool):
             raise InputError(f"dim must be 2 or 3, got {dim!r}")
+        if broad_phase not in ("grid", "sweep"):
+            raise InputError(f"broad_phase must be 'grid' or 'sweep', got {broad_phase!r}")
+        self.broad_phase = broad_phase
         self.dim = int(dim)
         if gravity is None:
             gravity = (0.0, -9.81) if dim == 2 else (0.0, 0.0, -9.81)
@@ -257,6 +265,9 @@ class Simulation(Runner, Results):
                 raise InputError(f"{name} must be (start, end) with start < end, both "
                                  f"finite, got {v!r}")
             new[k] = (lo, hi)
+        if any(p is not None for p in new) and self.broad_phase == "sweep":
+            raise InputError("periodic: broad_phase='sweep' does not support periodic axes "
+                             "(use broad_phase='grid')")
         if any(p is not None for p in new) and (self._slots or self._blocks):
             raise InputError("periodic: PCMM particles and blocks cannot be periodic (their "
                              "elements would span the boundary)")
@@ -472,8 +483,16 @@ class Simulation(Runner, Results):
         for k, (m, t) in enumerate(self._slots):
             if m is material and t == tol:
                 return k
+        self._refuse_sweep(f"material={material!r}")
         self._slots.append((material, tol))
         return len(self._slots) - 1
+
+    def _refuse_sweep(self, what):
+        """PCMM bodies and blocks find their candidates in the grid's cells."""
+        if self.broad_phase == "sweep":
+            raise InputError(f"{what}: PCMM bodies and blocks need broad_phase='grid' (their "
+                             f"element search uses the cell grid), this simulation has "
+                             f"broad_phase='sweep'")
 
     def add_block(self, vertices, triangles, material, rigid=False, velocity=(0.0, 0.0)):
         """Add a block: a triangle mesh (vertices (V, 2), counter-clockwise triangles
@@ -490,6 +509,7 @@ class Simulation(Runner, Results):
                              f"tdem.Elastic(...), got {material!r}")
         if self._built:
             raise InputError("vertices: blocks must be added before the first run")
+        self._refuse_sweep("add_block")
         x, t = _mesh.check_mesh(vertices, triangles)
         used = np.zeros(len(x), bool)
         used[t.ravel()] = True
