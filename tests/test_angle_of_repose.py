@@ -39,6 +39,19 @@ def test_fit_leaves_out_the_apex_cap_and_the_toe():
     assert short["left"]["angle"] is None and short["right"]["angle"] is None
 
 
+def test_angle_difference_is_compared_only_where_the_seeds_resolve_it():
+    # the paper preset's wedge heaps: 9.4° ± 2.4° (s.e.), resolved
+    d, se, ok = ar.angle_difference([31.6, 36.7, 34.9], [27.9, 25.6, 21.4])
+    assert d == pytest.approx(9.4, abs=0.05)
+    assert se == pytest.approx(math.sqrt((2.585 ** 2 + 3.302 ** 2) / 3), rel=1e-3)
+    assert ok
+    # the quick preset's small heaps: a spread of ±4–6° hides a 0.1° difference
+    d, se, ok = ar.angle_difference([16.0, 27.1, 20.5], [24.6, 20.5, 18.8])
+    assert abs(d) < 0.2 and se > 2.0 and not ok
+    # a resolved difference of the wrong sign is resolved (and so compared: it fails)
+    assert ar.angle_difference([20.0, 21.0, 19.0], [30.0, 31.0, 29.0])[2]
+
+
 def test_profile_takes_the_highest_top_of_each_bin():
     x = np.array([0.1, 0.2, 0.9, 1.5, 1.6]) * D
     tops = np.array([1.0, 3.0, 2.0, 0.5, 0.7]) * D
