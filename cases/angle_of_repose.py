@@ -88,7 +88,7 @@ the cubes 9.4° steeper, every heap at rest with the base carrying its weight to
 0.1 %. The layered heaps of the paper preset (and so its pressure comparison) have
 not been run to the end.
 
-Outputs (``--out DIR``, default out/angle_of_repose/PRESET)
+Outputs (``--out DIR``, default out/angle_of_repose, as every case)
 -----------------------------------------------------------
 ``heap_profiles.png`` (the heaps of cubes and of spheres side by side, the particles,
 the surface profiles and the fitted flanks with their angles), ``base_pressure.png``
@@ -99,7 +99,6 @@ the surface profiles and the fitted flanks with their angles), ``base_pressure.p
 """
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -664,8 +663,6 @@ def pressures(rs):
 
 def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
-    if args.out is None:
-        out = common.output_dir(CASE, str(Path("out") / CASE / args.preset))
     clock = common.Stopwatch()
     cfg = PRESETS[args.preset]
     opts = common.sim_options(args)
