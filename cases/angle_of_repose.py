@@ -22,6 +22,12 @@ off its ends and are taken out of the heap (held where they are, counted).
   angle of repose does not depend on E while the overlaps stay small, and the
   summary reports the mean and largest overlap over the particle size (the overlap
   volume over the cube's volume; about 0.1 % and 1 % in the quick preset).
+- Irregular polyhedra of a chosen aspect: each heap's grains are copies of one random
+  convex polyhedron, the hull of 12 random points on an ellipsoid of aspect 1.5
+  (``tdem.Polyhedron.random``, the heap's seed), scaled to the cube's volume, in
+  random orientations; the cubes' law. Being longer (bounding radius 1.04–1.22 d against the cube's 0.87 d), they need
+  a wider slab for three neighbour cells across the period: 7.5–8.5 d (the base has
+  5 rows across it). Wedge heaps only.
 - Spheres of the cubes' volume (radius 0.620 d), ρ = 2600 kg/m³, Hertz–Mindlin with
   E = 5e6 Pa, ν = 0.3, μ = 0.5, e = 0.3 (the same friction; a stiffer E, since a Hertz
   contact is softer at small overlaps: mean overlap over the radius about 0.5 %), no
@@ -60,7 +66,9 @@ What is compared (``summary.json``)
 -----------------------------------
 Pass or fail: the profile fit recovers the angle of a synthetic triangular heap
 (to 0.1°); the thesis's claim that the polyhedra stand steeper than spheres (the
-cubes' mean angle above the spheres', the seed spread beside it); every heap at rest
+cubes' mean angle above the spheres', and the irregular polyhedra's, the seed spread
+beside it; compared only where the difference exceeds twice its standard error over
+the seeds, as the pressure claims below, else reported as not resolved); every heap at rest
 at the end (kinetic energy per grain below 1e-5 m g d); the base carries each heap's
 weight (within 1 %); the thesis's pressure dip under a wedge heap and maximum under a
 layered heap, compared only where the difference (off-axis maximum − apex pressure)
@@ -115,6 +123,8 @@ GRAVITY = 9.81
 D = 0.01                      # the cube's edge (m)
 RHO = 2600.0
 FRICTION, RESTITUTION = 0.5, 0.3
+ASPECT = 1.5                  # irregular grains: longest over shortest axis of their ellipsoid
+IRREGULAR_POINTS = 12         # ... and the random points whose hull they are
 E_POLY = 2e5
 E_SPHERE, POISSON = 5e6, 0.3
 WIDTH = 6.5                   # slab width in d (the period must hold 3 neighbour cells)
@@ -139,24 +149,37 @@ def volume_radius(volume):
     return (3.0 * volume / (4.0 * math.pi)) ** (1.0 / 3.0)
 
 
+def irregular_shape(seed):
+    """The irregular grain of a heap: the convex hull of IRREGULAR_POINTS random points
+    on an ellipsoid of aspect ASPECT (tdem.Polyhedron.random, the heap's seed), scaled
+    to the cube's volume."""
+    unit = tdem.Polyhedron.random(IRREGULAR_POINTS, elongation=ASPECT, size=D, seed=seed)
+    size = D * (D ** 3 / unit.volume) ** (1.0 / 3.0)
+    return tdem.Polyhedron.random(IRREGULAR_POINTS, elongation=ASPECT, size=size, seed=seed)
+
+
 class Model:
     """One kind of grain: its shape (a Polyhedron, or None for spheres), its law and
-    the numbers the pour needs (bounding radius, volume, mass)."""
+    the numbers the pour needs (bounding radius, volume, mass). ``seed`` picks the
+    irregular grain of a heap (one random polyhedron per heap)."""
 
-    def __init__(self, name):
+    def __init__(self, name, seed=1):
         self.name = name
         cube = tdem.Polyhedron.cube(D)
         self.volume = cube.volume
-        if name == "cubes":
-            self.shape = cube
+        if name in ("cubes", "irregular"):
+            self.shape = cube if name == "cubes" else irregular_shape(seed)
             self.law = tdem.VolumeContact(young=E_POLY, friction=FRICTION,
                                           restitution=RESTITUTION)
-            self.bound = cube.bounding_radius
+            self.bound = self.shape.bounding_radius
             self.radius = None
             # the law's critical stiffness takes a contact area of π R², about 5 times a
-            # cube's face contact: 0.45 of its critical step is below the stable step of
-            # a dense packing of face contacts
+            # cube's face contact (more for the longer irregular grains): 0.45 of its
+            # critical step is below the stable step of a dense packing of face contacts
             self.dt_fraction = 0.45
+            # the period must hold three neighbour cells (2 bounding radii and the skin,
+            # about 0.25 d, each): the irregular grains, longer, need a wider slab
+            self.width = max(WIDTH, 0.5 * math.ceil(2.0 * 3.0 * (2.0 * self.bound / D + 0.3)))
         elif name == "spheres":
             self.shape = None
             self.law = tdem.HertzMindlin(young=E_SPHERE, poisson=POISSON, friction=FRICTION,
@@ -164,6 +187,7 @@ class Model:
             self.radius = volume_radius(self.volume)
             self.bound = self.radius
             self.dt_fraction = 0.2          # the engine's default
+            self.width = WIDTH
         else:
             raise ValueError(f"model {name!r}")
         self.mass = RHO * self.volume
@@ -188,12 +212,13 @@ class Model:
 
 
 # ------------------------------------------------------------------ the base
-def base_spheres(half_base, seed=0):
+def base_spheres(half_base, seed=0, width=WIDTH):
     """Centres and radius of the base: fixed spheres of the cubes' volume-equivalent
-    diameter on a jittered grid over [−L, L] × [0, W), 4 rows across the slab."""
+    diameter on a jittered grid over [−L, L] × [0, W), 4 rows across the slab of
+    WIDTH (as many more as a wider slab needs for the same spacing)."""
     r = volume_radius(D ** 3)
-    w = WIDTH * D
-    rows = 4
+    w = width * D
+    rows = max(4, int(round(4 * width / WIDTH)))
     sx = 2.5 * r
     nx = int(2 * half_base * D / sx)
     xs = (np.arange(nx) - 0.5 * (nx - 1)) * sx
@@ -208,9 +233,9 @@ def base_spheres(half_base, seed=0):
     return np.array(pts), r
 
 
-def floor_mesh(half_base):
+def floor_mesh(half_base, width=WIDTH):
     """The flat floor under the base: x in [−L, L], across three periods in y."""
-    L, w = half_base * D, WIDTH * D
+    L, w = half_base * D, width * D
     v = np.array([[-L, -w, 0.0], [L, -w, 0.0], [L, 2 * w, 0.0], [-L, 2 * w, 0.0]])
     return v, np.array([[0, 1, 2], [0, 2, 3]])
 
@@ -224,14 +249,14 @@ class Heap:
         self.rng = np.random.default_rng(seed)
         self.sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -GRAVITY),
                                    dt_fraction=model.dt_fraction, progress=False, **opts)
-        self.width = WIDTH * D
+        self.width = model.width * D
         self.sim.periodic(y=(0.0, self.width))
         self.half = cfg["half_base"] * D
         # the floor and the base spheres carry the polyhedra's law in a cube model
-        v, t = floor_mesh(cfg["half_base"])
+        v, t = floor_mesh(cfg["half_base"], model.width)
         floor_law = model.law
         self.floor = self.sim.add_mesh(v, t, contact=floor_law)
-        pts, rb = base_spheres(cfg["half_base"])
+        pts, rb = base_spheres(cfg["half_base"], width=model.width)
         hm = (model.law if model.shape is None else
               tdem.HertzMindlin(young=E_SPHERE, poisson=POISSON, friction=FRICTION,
                                 restitution=RESTITUTION))
@@ -378,9 +403,10 @@ class Heap:
         v = p["velocity"][ids]
         w = p["omega"][ids]
         m = p["mass"][ids]
-        # rotation: a cube's (and a sphere's) moment of inertia about any axis
-        inertia = m * (D ** 2 / 6.0 if self.model.shape is not None
-                       else 0.4 * self.model.radius ** 2)
+        # rotation: a sphere's moment of inertia, a cube's about any axis (D²/6 per
+        # unit mass), an irregular grain's mean principal moment
+        inertia = m * (float(np.mean(self.model.shape.principal_moments))
+                       if self.model.shape is not None else 0.4 * self.model.radius ** 2)
         ke = 0.5 * (m * (v * v).sum(1) + inertia * (w * w).sum(1)).sum()
         return float(ke / len(ids) / (self.model.mass * GRAVITY * D))
 
@@ -567,7 +593,7 @@ def fmt_angle(angles):
 # ------------------------------------------------------------------ plots
 def plot_profiles(runs, png):
     plt = common.pyplot()
-    models = [m for m in ("cubes", "spheres") if (m, "wedge") in runs]
+    models = [m for m in ("cubes", "irregular", "spheres") if (m, "wedge") in runs]
     fig, axes = plt.subplots(len(models), 1, figsize=(9, 2.2 * len(models) + 0.8),
                              sharex=True, squeeze=False)
     colors = ("tab:blue", "tab:orange", "tab:green")
@@ -631,8 +657,8 @@ def plot_pressure(press, png):
 def plot_angles(runs, png):
     plt = common.pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 3.8))
-    keys = [k for k in (("cubes", "wedge"), ("cubes", "layered"), ("spheres", "wedge"))
-            if k in runs]
+    keys = [k for k in (("cubes", "wedge"), ("cubes", "layered"), ("irregular", "wedge"),
+                        ("spheres", "wedge")) if k in runs]
     for i, k in enumerate(keys):
         for j, r in enumerate(runs[k]):
             for side, mk in (("left", "<"), ("right", ">")):
@@ -652,6 +678,29 @@ def plot_angles(runs, png):
 
 
 # ------------------------------------------------------------------ main
+HEAPS = (("cubes", "wedge"), ("spheres", "wedge"), ("cubes", "layered"),
+         ("irregular", "wedge"))
+
+
+def steeper_check(key, what, a, b, a_ms, b_ms):
+    """The thesis's claim that polyhedra stand steeper than spheres, for the heaps of
+    ``a`` against those of ``b`` (angles per seed; a_ms, b_ms their mean and std):
+    compared where the seeds resolve the difference, else reported."""
+    diff, se, resolved = angle_difference(a, b)
+    note = (f"the thesis: polyhedra stand steeper than spheres ({NO_NUMBERS}); {what} "
+            f"{a_ms[0]:.1f}° ± {a_ms[1]:.1f}°, spheres {b_ms[0]:.1f}° ± {b_ms[1]:.1f}° "
+            f"(mean ± std over {len(a)} seeds); the difference {diff:.1f}° ± {se:.1f}° "
+            f"(s.e. over the seeds)")
+    if resolved:
+        return common.check(key, diff, None, common.between(min=0.0), "deg",
+                            note + "; resolved (the difference exceeds twice its "
+                            "standard error)")
+    return common.check(key, diff, None, None, "deg",
+                        note + "; NOT resolved: the difference is within twice its "
+                        "standard error, so these heaps are too small to tell (reported, "
+                        "not compared)")
+
+
 def pressures(rs):
     """Mean, standard error and each seed's profile of a set of heaps."""
     each = np.array([r["pressure"] for r in rs])
@@ -669,10 +718,10 @@ def main(argv=None):
     vtu = out / "vtu"
     vtu.mkdir(exist_ok=True)
     runs = {}
-    for name, seq in (("cubes", "wedge"), ("spheres", "wedge"), ("cubes", "layered")):
-        model = Model(name)
+    for name, seq in HEAPS:
         runs[(name, seq)] = []
         for seed in cfg["seeds"]:
+            model = Model(name, seed)
             angle = None
             if seq == "layered":
                 wedge = [r for r in runs[(name, "wedge")] if r["seed"] == seed][0]
@@ -719,26 +768,21 @@ def finish(args, out, cfg, runs, clock):
                 "", note + "; NOT resolved: the difference is within twice its standard "
                 "error, so this heap is too small to tell (reported, not compared)"))
     fell = [r["fallen"] for r in allr]
-    diff, diff_se, resolved = angle_difference([r["angle"] for r in cubes],
-                                               [r["angle"] for r in spheres])
-    note = (f"the thesis: polyhedra stand steeper than spheres ({NO_NUMBERS}); cubes "
-            f"{a_c[0]:.1f}° ± {a_c[1]:.1f}°, spheres {a_s[0]:.1f}° ± {a_s[1]:.1f}° (mean ± "
-            f"std over {len(cubes)} seeds); the difference {diff:.1f}° ± {diff_se:.1f}° "
-            f"(s.e. over the seeds)")
-    if resolved:
-        angle_check = common.check(
-            "cubes_minus_spheres.angle", diff, None, common.between(min=0.0), "deg",
-            note + "; resolved (the difference exceeds twice its standard error)")
-    else:
-        angle_check = common.check(
-            "cubes_minus_spheres.angle", diff, None, None, "deg",
-            note + "; NOT resolved: the difference is within twice its standard error, so "
-            "these heaps are too small to tell (reported, not compared)")
+    angle_checks = [steeper_check("cubes_minus_spheres.angle", "cubes",
+                                  [r["angle"] for r in cubes], [r["angle"] for r in spheres],
+                                  a_c, a_s)]
+    irregular = runs.get(("irregular", "wedge"), [])
+    if irregular:
+        a_i = mean_std([r["angle"] for r in irregular])
+        angle_checks.append(steeper_check(
+            "irregular_minus_spheres.angle",
+            f"irregular polyhedra (aspect {ASPECT}, {IRREGULAR_POINTS} hull points)",
+            [r["angle"] for r in irregular], [r["angle"] for r in spheres], a_i, a_s))
     checks = [
         common.check("fit.synthetic_heap_error", synth_err, 0.0, common.absolute(0.1), "deg",
                      "the profile fit on a synthetic triangular heap of 33°: the largest "
                      "error of its two flanks"),
-        angle_check,
+        *angle_checks,
         common.check("heaps.at_rest", [r["kinetic_ratio"] for r in allr], None,
                      common.between(max=REST), "",
                      "kinetic energy per grain over m g d at the end, every heap"),
@@ -755,6 +799,9 @@ def finish(args, out, cfg, runs, clock):
         common.check("cubes_layered.angle", a_l[0], None, None, "deg",
                      f"layered heaps of cubes (their layers set back at 0.85 × the wedge "
                      f"angle; std {a_l[1]:.2f}°)"),
+        *([common.check("irregular.angle", a_i[0], None, None, "deg",
+                        f"wedge heaps of irregular polyhedra, one random grain per seed "
+                        f"(std {a_i[1]:.2f}°)")] if irregular else []),
         common.check("cubes.overlap_mean", float(np.mean([r["overlap_mean"] for r in cubes])),
                      None, None, "", "mean overlap volume over the cube's volume"),
         common.check("spheres.overlap_mean",

@@ -78,6 +78,22 @@ def test_pressure_profile_and_its_shape():
     assert not noisy["resolved"]
 
 
+def test_irregular_grain_has_the_cubes_volume_and_its_aspect():
+    for seed in (1, 2, 3):
+        m = ar.Model("irregular", seed)
+        assert m.shape.volume == pytest.approx(D ** 3, rel=1e-12)
+        assert len(m.shape.vertices) <= ar.IRREGULAR_POINTS
+        # the hull of points on an ellipsoid of aspect 1.5 (semi-axes size, size/1.5,
+        # size/1.5), longer than it is wide
+        x = np.asarray(m.shape.input_vertices) * [1.0, ar.ASPECT, ar.ASPECT]
+        r2 = (x * x).sum(axis=1)
+        assert np.allclose(r2, r2[0], rtol=1e-12)
+        extent = np.ptp(m.shape.vertices, axis=0)          # along its principal axes
+        assert extent.max() > 1.3 * extent.min()
+    assert not np.allclose(ar.Model("irregular", 1).shape.vertices,
+                           ar.Model("irregular", 2).shape.vertices)
+
+
 def test_cube_top_is_its_highest_vertex():
     m = ar.Model("cubes")
     # a cube turned 45° about x: its top is half a face diagonal above the centre
@@ -91,12 +107,13 @@ def test_cube_top_is_its_highest_vertex():
 
 @pytest.fixture(scope="module")
 def heaps():
-    """Small wedge heaps (150 grains) of cubes and of spheres, one seed each."""
+    """Small wedge heaps (150 grains) of cubes, irregular polyhedra and spheres, one
+    seed each."""
     cfg = dict(ar.PRESETS["quick"], particles=150, half_base=14.0, settle_max=1.0)
     # the process's thread count (the suite's workers may have started Taichi already)
     opts = {"threads": None}
     out = {}
-    for name in ("cubes", "spheres"):
+    for name in ("cubes", "irregular", "spheres"):
         r, heap = ar.run_heap(ar.Model(name), "wedge", cfg, opts, seed=1, log=lambda s: None)
         out[name] = r
     return out
@@ -125,7 +142,8 @@ def test_summary_schema_of_a_finished_run(heaps, tmp_path):
     # statistics, is under test): it follows the schema
     runs = {("cubes", "wedge"): [heaps["cubes"]] * 3,
             ("spheres", "wedge"): [heaps["spheres"]] * 3,
-            ("cubes", "layered"): [heaps["cubes"]] * 3}
+            ("cubes", "layered"): [heaps["cubes"]] * 3,
+            ("irregular", "wedge"): [heaps["irregular"]] * 3}
 
     class Args:
         preset, threads = "quick", 1

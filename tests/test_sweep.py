@@ -9,6 +9,9 @@ import pytest
 import tdem
 from tdem.neighbors import F_BUILDS
 
+# random packings that start with overlaps (the same in both broad phases)
+pytestmark = pytest.mark.filterwarnings("ignore:positions.*overlapping:RuntimeWarning")
+
 
 def spheres(broad_phase, n=300, seed=0):
     rng = np.random.default_rng(seed)
