@@ -107,6 +107,7 @@ the surface profiles and the fitted flanks with their angles), ``base_pressure.p
 """
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -497,15 +498,23 @@ def synthetic_cone(angle, half_width, bin_width=BIN, points=4000, seed=0):
     return xs, zs
 
 
-def pressure_profile(base_x, base_fz, floor_fz, half_base, width, bin_width=P_BIN * D):
-    """(bin centres |x|, pressure): the vertical force on the base spheres binned by
-    |x| (both sides folded), over the bin's area (2 × bin width × slab width); the
-    floor's force, if any, spread over the whole base."""
+def pressure_profile(base_x, base_fz, floor_fz, half_base, width, bin_width=P_BIN * D,
+                     cell_area=None):
+    """(bin centres |x|, pressure): the base spheres' vertical forces binned by |x| (both
+    sides folded). With ``cell_area`` (each base sphere's share of the base), a bin's
+    pressure is the mean of its spheres' f/cell_area: the base's lattice (columns
+    0.78 d apart) against bins 2 d wide would otherwise put 2 or 3 columns in a bin,
+    a ±20 % ripple of the bins alone; without it, the force over the bin's area
+    (2 × bin width × slab width). The floor's force, if any, spread over the whole
+    base."""
     ax = np.abs(np.asarray(base_x, dtype=float))
     nb = int(math.ceil(half_base / bin_width))
     edges = np.arange(nb + 1) * bin_width
     f = np.histogram(ax, bins=edges, weights=base_fz)[0]
-    area = 2.0 * bin_width * width
+    if cell_area is None:
+        area = 2.0 * bin_width * width
+    else:
+        area = np.maximum(np.histogram(ax, bins=edges)[0], 1) * cell_area
     p = f / area + floor_fz / (2.0 * half_base * width)
     return 0.5 * (edges[1:] + edges[:-1]), p
 
@@ -552,6 +561,11 @@ def angle_difference(a, b):
     return diff, se, abs(diff) > 2.0 * se
 
 
+def base_cell(half_base, width, count):
+    """Each base sphere's share of the base (m²)."""
+    return 2.0 * half_base * width / count
+
+
 # ------------------------------------------------------------------ runs
 def run_heap(model, sequence, cfg, opts, seed, angle=None, log=print):
     w0 = time.perf_counter()
@@ -565,7 +579,8 @@ def run_heap(model, sequence, cfg, opts, seed, angle=None, log=print):
     centres, heights = profile(m["x"], m["tops"], BIN * D, base=heap.base_top)
     fit = fit_flanks(centres, heights)
     px, pp = pressure_profile(m["base_x"], m["base_fz"], m["floor_fz"], heap.half,
-                              heap.width)
+                              heap.width, cell_area=base_cell(heap.half, heap.width,
+                                                              len(m["base_x"])))
     angles = [fit[s]["angle"] for s in ("left", "right")]
     mean = mean_std(angles)[0]
     # packing: the grains' volume over the area under the profile × slab width
@@ -853,8 +868,63 @@ def save_heaps(path, runs):
             series[f"{m}_{s}_seed{r['seed']}"] = {
                 "x": r["x"], "y": r["y"], "z": r["z"], "tops": r["tops"],
                 "profile_x": r["profile_x"], "profile_h": r["profile_h"],
-                "pressure_x": r["pressure_x"], "pressure": r["pressure"]}
+                "pressure_x": r["pressure_x"], "pressure": r["pressure"],
+                "base_x": r["base_x"], "base_fz": r["base_fz"],
+                "floor_fz": [r["floor_fz"]]}
     common.save_histories(path, series)
+
+
+def reanalyse(source, out, extra=(), threads=1):
+    """The summary, plots and heaps of a finished run made again from what it saved
+    (``source``: its folder — summary.json, heaps.h5 and, for runs that saved no base
+    forces in heaps.h5, the final heaps' VTU files), with this module's analysis;
+    ``extra``: result dicts of more heaps (:func:`run_heap`'s, e.g. run one seed at a
+    time) to add. Writes to ``out``; returns the summary."""
+    import json
+    import types
+
+    import h5py
+    import meshio
+
+    source, out = Path(source), common.output_dir(CASE, out)
+    old = json.loads((source / "summary.json").read_text())
+    cfg = old["data"]["preset"]
+    runs, wall = {}, 0.0
+    with h5py.File(source / "heaps.h5", "r") as f:
+        for h in old["data"]["heaps"]:
+            key = f"{h['model']}_{h['sequence']}_seed{h['seed']}"
+            g = {k: np.asarray(v) for k, v in f[key].items()}
+            model = Model(h["model"], h["seed"])
+            width = model.width * D
+            pts, rb = base_spheres(cfg["half_base"], width=model.width)
+            if "base_fz" in g:
+                base_x, base_fz, floor_fz = g["base_x"], g["base_fz"], float(g["floor_fz"][0])
+            else:
+                # the base spheres are the first particles; the floor carries the rest
+                # of the weight the base was measured to carry
+                vtu = meshio.read(source / "vtu" / f"{key}.vtu")
+                order = np.argsort(vtu.point_data["id"].ravel())
+                base_x = pts[:, 0]
+                base_fz = -vtu.point_data["force"][order][:len(pts), 2]
+                weight = h["grains"] * model.mass * GRAVITY
+                floor_fz = h["balance"] * weight - float(base_fz.sum())
+            px, pp = pressure_profile(base_x, base_fz, floor_fz, cfg["half_base"] * D, width,
+                                      cell_area=base_cell(cfg["half_base"] * D, width,
+                                                          len(base_x)))
+            fit = fit_flanks(g["profile_x"], g["profile_h"])
+            r = {**h, "fit": fit, "angle": mean_std([fit[sd]["angle"]
+                                                     for sd in ("left", "right")])[0],
+                 "x": g["x"], "y": g["y"], "z": g["z"], "tops": g["tops"],
+                 "profile_x": g["profile_x"], "profile_h": g["profile_h"],
+                 "pressure_x": px, "pressure": pp, "base_x": base_x, "base_fz": base_fz,
+                 "floor_fz": floor_fz, "base_top": float((pts[:, 2] + rb).max())}
+            runs.setdefault((h["model"], h["sequence"]), []).append(r)
+            wall += h["wall_s"]
+    for r in extra:
+        runs.setdefault((r["model"], r["sequence"]), []).append(r)
+        wall += r["wall_s"]
+    args = types.SimpleNamespace(preset=old["preset"], threads=threads)
+    return finish(args, out, cfg, runs, lambda: wall)
 
 
 if __name__ == "__main__":

@@ -39,6 +39,21 @@ def test_fit_leaves_out_the_apex_cap_and_the_toe():
     assert short["left"]["angle"] is None and short["right"]["angle"] is None
 
 
+def test_pressure_of_a_uniform_load_on_the_base_lattice_is_flat():
+    # the case's base: columns 0.775 d apart against bins 2 d wide — 2 or 3 columns a
+    # bin; the same force on every sphere is a uniform pressure f / (its share of the
+    # base), which each sphere's share gives exactly, the bin's area does not
+    half, w = 34.0 * D, 6.5 * D
+    pts, rb = ar.base_spheres(34.0)
+    f = np.full(len(pts), 0.01)
+    cell = ar.base_cell(half, w, len(pts))
+    c, p = ar.pressure_profile(pts[:, 0], f, 0.0, half, w, cell_area=cell)
+    inside = c < half - 2 * D
+    assert np.allclose(p[inside], 0.01 / cell, rtol=1e-12)
+    c, rippled = ar.pressure_profile(pts[:, 0], f, 0.0, half, w)
+    assert np.ptp(rippled[inside]) / np.mean(rippled[inside]) > 0.2
+
+
 def test_angle_difference_is_compared_only_where_the_seeds_resolve_it():
     # the paper preset's wedge heaps: 9.4° ± 2.4° (s.e.), resolved
     d, se, ok = ar.angle_difference([31.6, 36.7, 34.9], [27.9, 25.6, 21.4])
