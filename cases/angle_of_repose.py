@@ -921,7 +921,14 @@ def reanalyse(source, out, extra=(), threads=1):
             runs.setdefault((h["model"], h["sequence"]), []).append(r)
             wall += h["wall_s"]
     for r in extra:
-        runs.setdefault((r["model"], r["sequence"]), []).append(r)
+        model = Model(r["model"], r["seed"])
+        width = model.width * D
+        px, pp = pressure_profile(r["base_x"], r["base_fz"], r["floor_fz"],
+                                  cfg["half_base"] * D, width,
+                                  cell_area=base_cell(cfg["half_base"] * D, width,
+                                                      len(r["base_x"])))
+        runs.setdefault((r["model"], r["sequence"]), []).append(
+            {**r, "pressure_x": px, "pressure": pp})
         wall += r["wall_s"]
     args = types.SimpleNamespace(preset=old["preset"], threads=threads)
     return finish(args, out, cfg, runs, lambda: wall)
