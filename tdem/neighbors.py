@@ -260,7 +260,6 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
             ri = prop[i][PROP_RADIUS]
             ci = cell_of(xi, gridp, gridn)
             cnt = 0
-            back = 0
             for off in ti.static(ti.grouped(ti.ndrange(*([(-1, 2)] * dim)))):
                 if True:
                     cc = ci + off
@@ -277,13 +276,11 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
                             if j != i:
                                 d = image(pos[j] - xi, per)
                                 cut = ri + prop[j][PROP_RADIUS] + skin
-                                if d.dot(d) < cut * cut:
-                                    if j > i:
-                                        insert_partner(nbr, i, cnt, j)
-                                        cnt += 1
-                                    else:
-                                        back += 1
-            ti.atomic_max(flags[F_NEED], ti.max(cnt, back))
+                                if d.dot(d) < cut * cut and j > i:
+                                    insert_partner(nbr, i, cnt, j)
+                                    cnt += 1
+            # (the partners below i are counted by the reverse lists, finish_build)
+            ti.atomic_max(flags[F_NEED], cnt)
             close_half_list(i, cnt, nbr, ncnt, hist, nbr_old, ncnt_old, hist_old)
             xref[i] = xi
             rcnt[i] = 0
