@@ -499,24 +499,19 @@ def synthetic_cone(angle, half_width, bin_width=BIN, points=4000, seed=0):
     return xs, zs
 
 
-def pressure_profile(base_x, base_fz, floor_fz, half_base, width, bin_width=P_BIN * D,
-                     cell_area=None):
-    """(bin centres |x|, pressure): the base spheres' vertical forces binned by |x| (both
-    sides folded). With ``cell_area`` (each base sphere's share of the base), a bin's
-    pressure is the mean of its spheres' f/cell_area: the base's lattice (columns
-    0.78 d apart) against bins 2 d wide would otherwise put 2 or 3 columns in a bin,
-    a ±20 % ripple of the bins alone; without it, the force over the bin's area
-    (2 × bin width × slab width). The floor's force, if any, spread over the whole
-    base."""
+def pressure_profile(base_x, base_fz, floor_fz, half_base, width, cell_area,
+                     bin_width=P_BIN * D):
+    """(bin centres |x|, pressure): each base sphere's vertical force over its share of
+    the base (``cell_area``), averaged in bins of |x| (both sides folded); the floor's
+    force, if any, spread over the whole base. (The force over a bin's area would put
+    2 or 3 of the base's columns, 0.78 d apart, in bins 2 d wide: a ±20 % ripple of the
+    binning alone.)"""
     ax = np.abs(np.asarray(base_x, dtype=float))
     nb = int(math.ceil(half_base / bin_width))
     edges = np.arange(nb + 1) * bin_width
     f = np.histogram(ax, bins=edges, weights=base_fz)[0]
-    if cell_area is None:
-        area = 2.0 * bin_width * width
-    else:
-        area = np.maximum(np.histogram(ax, bins=edges)[0], 1) * cell_area
-    p = f / area + floor_fz / (2.0 * half_base * width)
+    count = np.maximum(np.histogram(ax, bins=edges)[0], 1)
+    p = f / (count * cell_area) + floor_fz / (2.0 * half_base * width)
     return 0.5 * (edges[1:] + edges[:-1]), p
 
 
@@ -580,8 +575,7 @@ def run_heap(model, sequence, cfg, opts, seed, angle=None, log=print):
     centres, heights = profile(m["x"], m["tops"], BIN * D, base=heap.base_top)
     fit = fit_flanks(centres, heights)
     px, pp = pressure_profile(m["base_x"], m["base_fz"], m["floor_fz"], heap.half,
-                              heap.width, cell_area=base_cell(heap.half, heap.width,
-                                                              len(m["base_x"])))
+                              heap.width, base_cell(heap.half, heap.width, len(m["base_x"])))
     angles = [fit[s]["angle"] for s in ("left", "right")]
     mean = mean_std(angles)[0]
     # packing: the grains' volume over the area under the profile × slab width
@@ -910,8 +904,7 @@ def reanalyse(source, out, extra=(), threads=1):
                 weight = h["grains"] * model.mass * GRAVITY
                 floor_fz = h["balance"] * weight - float(base_fz.sum())
             px, pp = pressure_profile(base_x, base_fz, floor_fz, cfg["half_base"] * D, width,
-                                      cell_area=base_cell(cfg["half_base"] * D, width,
-                                                          len(base_x)))
+                                      base_cell(cfg["half_base"] * D, width, len(base_x)))
             fit = fit_flanks(g["profile_x"], g["profile_h"])
             r = {**h, "fit": fit, "angle": mean_std([fit[sd]["angle"]
                                                      for sd in ("left", "right")])[0],
@@ -926,8 +919,7 @@ def reanalyse(source, out, extra=(), threads=1):
         width = model.width * D
         px, pp = pressure_profile(r["base_x"], r["base_fz"], r["floor_fz"],
                                   cfg["half_base"] * D, width,
-                                  cell_area=base_cell(cfg["half_base"] * D, width,
-                                                      len(r["base_x"])))
+                                  base_cell(cfg["half_base"] * D, width, len(r["base_x"])))
         runs.setdefault((r["model"], r["sequence"]), []).append(
             {**r, "pressure_x": px, "pressure": pp})
         wall += r["wall_s"]
