@@ -17,6 +17,10 @@ Prints ``PEER tdem <threads> particle_steps_per_s <value>`` like the peers' scri
     python benchmarks/pack3d.py --ellipsoids           # the same bed of ellipsoids
     python benchmarks/pack3d.py --cubes                # about 20,000 cubes
     python benchmarks/pack3d.py --cubes --yade         # ... and Yade's Polyhedra on them
+    python benchmarks/pack3d.py --broad-phase sweep    # sort-and-sweep instead of the grid
+    python benchmarks/pack3d.py --cubes --pour         # cubes falling: the lists rebuilt often
+
+Every run prints how many list builds its timed steps made and their time.
 
 ``--ellipsoids``: the same number of ellipsoids of semi-axes 2, 1.6 and 1.2 mm (aspect
 1.67), their axes along x, y, z, on the lattice stretched by (1, 0.8, 0.6): the affine
