@@ -39,12 +39,13 @@ def shape_of(s, r):
 @ti.func
 def shaped_pair(i, k, xi, vi, wi, mi, li, ci, sni, shi, rbi, pos: ti.template(),
                 vel: ti.template(), omega: ti.template(), prop: ti.template(),
-                plaw: ti.template(), angle: ti.template(), shp: ti.template(),
+                plaw: ti.template(), turn: ti.template(), shp: ti.template(),
                 lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                 hist: ti.template(), cn: ti.template(), cs: ti.template(),
                 flags: ti.template(), dt, detail: ti.template(), laws: ti.template(), per):
     """Contact in slot k of particle i (the owner) when either body has a shape
-    (``ci``, ``sni``: the cosine and sine of i's angle); returns (f_i, M_i, M_j,
+    (``ci``, ``sni``: the cosine and sine of i's angle; ``turn``: those of every
+    particle); returns (f_i, M_i, M_j,
     dissipated energy), as :func:`tdem.step.pair_contact`."""
     R = ti.static(history_width(laws))
     PHI = ti.static(R + 4)
@@ -53,9 +54,8 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, ci, sni, shi, rbi, pos: ti.template(),
     pj = prop[j]
     rbj = pj[PROP_RADIUS]
     shj = shape_of(shp[j], rbj)
-    thj = angle[j]
-    cj = ti.cos(thj)
-    snj = ti.sin(thj)
+    cj = turn[j][0]
+    snj = turn[j][1]
     d = image(pos[j] - xi, per)        # j at its image nearest to i
     xj = xi + d
     h = hist[i, k]

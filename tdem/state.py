@@ -72,6 +72,8 @@ ENGINE = (
     Array("pos0", "particle", "D", "f", "dynamic",
           doc="position at the start (displacement; shifted with a periodic wrap)"),
     Array("facc", "particle", "DS", "f", "scratch", doc="force and moment sums of a step"),
+    Array("turn", "particle", {2: 2, 3: 0}, "f", "scratch",
+          doc="2D: cos θ, sin θ of each particle's angle at the step's start"),
     Array("eacc", "particle", 2, "f", "dynamic", doc="dissipated energy, boundary work (J/m)"),
     Array("estate", "particle", 2, "f", "dynamic", doc="kinetic, gravitational energy at t_n"),
     Array("ework", "particle", 7, "f", "dynamic",

@@ -422,7 +422,8 @@ def servo_velocity(wall: ti.template(), wforce: ti.template(), w, dt):
 @cached
 @ti.kernel
 def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
-         angle: ti.types.ndarray(), shp: ti.types.ndarray(), prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
+         angle: ti.types.ndarray(), turn: ti.types.ndarray(), shp: ti.types.ndarray(),
+         prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
          vfix: ti.types.ndarray(), force: ti.types.ndarray(), torque: ti.types.ndarray(),
          xref: ti.types.ndarray(), pos0: ti.types.ndarray(), facc: ti.types.ndarray(),
          eacc: ti.types.ndarray(),
@@ -474,6 +475,12 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     for w in range(nw):
         wforce[w] = wforce[w] * 0.0
 
+    if ti.static(shapes and dim == 2):
+        # each angle's cosine and sine once, for all the pairs it takes part in
+        ti.loop_config(serialize=serial)
+        for i in range(n):
+            turn[i] = ti.Vector([ti.cos(angle[i]), ti.sin(angle[i])])
+
     # 1. contact forces at x_n: each pair once, by its owner (the lower index). On one
     #    thread the partner's share goes straight into its sum; in parallel it is kept
     #    in the slot and gathered in 2. (no atomics, a fixed summation order).
@@ -493,9 +500,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         sthi = 0.0
         mati = ti.Matrix.identity(float, 3)
         if ti.static(shapes and dim == 2):
-            thi = angle[i]
-            cthi = ti.cos(thi)
-            sthi = ti.sin(thi)
+            cthi = turn[i][0]
+            sthi = turn[i][1]
             shi = shape_of(shp[i], pi[PROP_RADIUS])
             ishaped = shp[i][2] > 0.0
         ipoly = False
@@ -555,7 +561,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     if shaped:
                         fk, mk, mjk, dk = shaped_pair(
                             i, k, xi, vi, wi, pi[PROP_MASS], li, cthi, sthi, shi, pi[PROP_RADIUS],
-                            pos, vel, omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist,
+                            pos, vel, omega, prop, plaw, turn, shp, lawp, lawpair, nbr, hist,
                             cn, cs, flags, dt, detail, laws, per)
                     else:
                         fk, mk, mjk, dk = pair_contact(

@@ -105,6 +105,43 @@ def test_depth_matches_a_dense_scan_and_is_symmetric(depth_kernel):
             np.testing.assert_allclose(n2, -n, atol=1e-10)
 
 
+def test_warm_started_depth_stops_within_its_tolerance(depth_kernel):
+    """From a stored normal off the minimum by up to 1e-3 rad (what one step turns a
+    contact by), the depth and normal agree with the cold solution: the last step on
+    the cubic model leaves the support points facing each other within 1e-6 of the
+    size, so the depth within 1e-12 m and the normal within 1e-6 rad here."""
+    from physics.geometry import superellipse as se
+
+    @ti.kernel
+    def warm(si: ti.types.vector(3, ti.f64), ti_: ti.f64, sj: ti.types.vector(3, ti.f64),
+             tj: ti.f64, d: ti.types.vector(2, ti.f64), phi0: ti.f64) -> ti.types.vector(4, ti.f64):
+        f, u, pi, pj, phi, ok, ri, rj = se.pair_depth(si, ti.cos(ti_), ti.sin(ti_), sj,
+                                                      ti.cos(tj), ti.sin(tj), d, phi0, True,
+                                                      False)
+        return ti.Vector([f, u[0], u[1], ti.cast(ok, ti.f64)])
+
+    rng = np.random.default_rng(11)
+    checked = 0
+    for a, b in ((SHAPES[0], SHAPES[1]), (SHAPES[0], SHAPES[0]), (SHAPES[2], SHAPES[3])):
+        for _ in range(5):
+            ta, tb, dirn = rng.uniform(0, 2 * math.pi, 3)
+            for dist in (0.2, 0.3):
+                d = dist * np.array([math.cos(dirn), math.sin(dirn)])
+                f, n = depth_kernel(a, ta, b, tb, d)
+                if f < 0.0:
+                    continue
+                phi = math.atan2(n[1], n[0])
+                for off in (1e-3, -3e-4, 1e-5):
+                    r = warm(ti.Vector(a.row), ta, ti.Vector(b.row), tb,
+                             ti.Vector(list(map(float, d))), phi + off)
+                    assert r[3] == 1.0
+                    assert r[0] == pytest.approx(f, abs=1e-12)
+                    assert np.degrees(np.arccos(min(1.0, np.array([r[1], r[2]]) @ n))) < \
+                        np.degrees(1e-6)
+                    checked += 1
+    assert checked > 40
+
+
 def test_geometric_potential_method_agrees_at_small_overlaps(depth_kernel):
     rng = np.random.default_rng(5)
     a, b = SHAPES[0], SHAPES[2]
@@ -128,15 +165,22 @@ def test_geometric_potential_method_agrees_at_small_overlaps(depth_kernel):
 @pytest.mark.parametrize("s", SHAPES, ids=repr)
 def test_curvature_radius_is_the_turn_of_the_support_point(depth_kernel, s):
     """ρ = t·dp/dφ (central difference of the numpy support point) and, for an ellipse,
-    a²b²/h³."""
+    a²b²/h³; its derivative dρ/dφ (the Newton stop's third derivative) against a
+    central difference of ρ."""
     from physics.geometry import superellipse as se
 
     @ti.kernel
-    def rho(sh: ti.types.vector(3, ti.f64), phi: ti.f64) -> ti.f64:
-        h, p, r = se.support_curv(sh, 1.0, 0.0, ti.Vector([ti.cos(phi), ti.sin(phi)]))
-        return r
+    def rho_drho(sh: ti.types.vector(3, ti.f64), phi: ti.f64) -> ti.types.vector(2, ti.f64):
+        h, p, r, dr = se.support_curv(sh, 1.0, 0.0, ti.Vector([ti.cos(phi), ti.sin(phi)]))
+        return ti.Vector([r, dr])
+
+    def rho(sh, phi):
+        return rho_drho(sh, phi)[0]
 
     for phi in (0.3, 1.0, 2.2, 4.0):
+        eps = 1e-5
+        fd = (rho(ti.Vector(s.row), phi + eps) - rho(ti.Vector(s.row), phi - eps)) / (2 * eps)
+        assert rho_drho(ti.Vector(s.row), phi)[1] == pytest.approx(fd, rel=1e-6)
         eps = 1e-6
         u = lambda a: np.array([math.cos(a), math.sin(a)])
         dp = (s.support(u(phi + eps))[1] - s.support(u(phi - eps))[1]) / (2 * eps)
