@@ -105,6 +105,26 @@ def test_depth_matches_a_dense_scan_and_is_symmetric(depth_kernel):
             np.testing.assert_allclose(n2, -n, atol=1e-10)
 
 
+@pytest.mark.parametrize("n", [3.0, 4.0, 5.0, 8.0, 9.0, 4.5])
+def test_support_by_square_roots_matches_the_power_form(depth_kernel, n):
+    """Where 1/n or 1/(n − 1) is 1/2, 1/4 or 1/8 the kernel takes the powers by square
+    roots; its support function and point equal the numpy power form to round-off."""
+    from physics.geometry import superellipse as se
+    s = Superellipse(0.3, 0.12, n)
+
+    @ti.kernel
+    def sup(sh: ti.types.vector(3, ti.f64), phi: ti.f64) -> ti.types.vector(3, ti.f64):
+        h, p, r, dr = se.support_curv(sh, 1.0, 0.0, ti.Vector([ti.cos(phi), ti.sin(phi)]))
+        return ti.Vector([h, p[0], p[1]])
+
+    for phi in np.linspace(0.05, 6.2, 23):
+        u = np.array([math.cos(phi), math.sin(phi)])
+        h, p = s.support(u)
+        got = sup(ti.Vector(s.row), phi)
+        assert got[0] == pytest.approx(h, rel=1e-13)
+        np.testing.assert_allclose([got[1], got[2]], p, rtol=1e-12, atol=1e-15)
+
+
 def test_warm_started_depth_stops_within_its_tolerance(depth_kernel):
     """From a stored normal off the minimum by up to 1e-3 rad (what one step turns a
     contact by), the depth and normal agree with the cold solution: the last step on
