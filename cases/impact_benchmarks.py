@@ -78,8 +78,7 @@ incremental Mindlin spring dF_t/dt = -8 G* a s (s the slip of the contact points
 Coulomb's limit on the elastic normal force, the lever arms R - u/2, by fourth-order
 Runge-Kutta at 5,000 steps per contact (the limit applied to the force that acts and
 to the spring after each step; four times as many steps change the rebound by less
-than 2e-6 of the initial slip). It is
-checked where it is exact: where the contact slides throughout it gives the Coulomb
+than 2e-6 of the initial slip). It is checked where it is exact: where the contact slides throughout it gives the Coulomb
 solution above, and where 4 G*/E* K m* = 1 (no material has it: G*/E* = 1/14 for a
 sphere on a plane) the slip follows the normal speed, s(t) = s0 u'(t)/v_n, so that an
 elastic impact without a friction limit reverses the slip exactly (tests).
@@ -289,11 +288,16 @@ def compliant_impact(m1, r1, vn, vx1, w1, e_star, g_star, gamma, mu, m2=None, r2
     r2_ = 0.0 if plane else r2
     h = hertz(e_star, rs, ms, float(vn.max()))["time"] / steps
 
+    def elastic(d):
+        """(Hertz's elastic normal force, contact radius) at overlap d (0 when apart)."""
+        dp = np.maximum(d, 0.0)
+        a = np.sqrt(rs * dp)
+        return 4.0 / 3.0 * e_star * a * dp, a
+
     def forces(y):
         d, dd, v1, o1, v2, o2, f = y
         dp = np.maximum(d, 0.0)
-        a = np.sqrt(rs * dp)
-        fel = 4.0 / 3.0 * e_star * a * dp
+        fel, a = elastic(d)
         fn = fel + gamma * np.sqrt(2.0 * e_star * a * ms) * dd
         arm1 = r1 - 0.5 * dp
         arm2 = (r2_ - 0.5 * dp) if not plane else 0.0 * dp
@@ -311,8 +315,7 @@ def compliant_impact(m1, r1, vn, vx1, w1, e_star, g_star, gamma, mu, m2=None, r2
         k4 = forces([p + h * q for p, q in zip(y, k3)])
         y = [p + h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
              for p, q1, q2, q3, q4 in zip(y, k1, k2, k3, k4)]
-        d = np.maximum(y[0], 0.0)
-        limit = mu * 4.0 / 3.0 * e_star * np.sqrt(rs * d) * d
+        limit = mu * elastic(y[0])[0]
         y[6] = np.clip(y[6], -limit, limit)
         if np.all(y[0] < 0.0):          # all apart again (no force acts once apart)
             break
@@ -352,8 +355,8 @@ def compliant_series(test, material, angles, counter=False, steps=5000):
         m2, r2 = m1, r
     e_star, g_star = pair_moduli(mat, mat if m2 is not None else None)
     gamma = hertz_damping(e) if e < 1.0 else 0.0
-    vx, w, v2, w2_, _ = compliant_impact(m1, r, vn, vx1 + 0.0 * tan, w1 + 0.0 * tan, e_star,
-                                         g_star, gamma, mu, m2, r2, vx2, w2, steps=steps)
+    vx, w, v2, w2_, _ = compliant_impact(m1, r, vn, vx1, w1, e_star, g_star, gamma, mu, m2,
+                                         r2, vx2, w2, steps=steps)
     slip = vx - w * r - ((v2 + w2_ * r2) if m2 is not None else 0.0)
     return [{"vx": float(a), "wr": float(b) * r, "slip": float(c)}
             for a, b, c in zip(vx, w, slip)]

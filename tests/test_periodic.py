@@ -5,7 +5,8 @@
   runs on.
 - A frictionless, undamped gas of superellipses in a box periodic along x and y keeps
   its energy within 1 % over 20,000 steps at the default time-step fraction (20 seeds:
-  0.37 % ± 0.59 %, the largest 1.5 %) and within 0.5 % at half that step (all 20 seeds), and its linear momentum to 1e-10
+  0.37 % ± 0.59 %, the largest 1.5 %) and within 0.5 % at half that step (all 20
+  seeds), and its linear momentum to 1e-10
   (relative to Σ m|v|).
 - The same gas as a free cloud (no period, no walls) keeps its angular momentum
   Σ (x × m v + I ω) to 1e-10: the forces of a contact act at one point. (In a periodic

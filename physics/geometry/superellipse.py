@@ -108,11 +108,13 @@ def _root(x, k):
 
 @ti.func
 def support_curv(shp, c, s, u):
-    """(h(u), p(u), ρ(u)): the support function, the support point (world frame, from
-    the centre) and the radius of curvature there, ρ = tᵀ∇²h t. For n = 2,
-    ρ = a²b²/h³; else, with A = |a u'_x|, B = |b u'_y|, S = A^q + B^q,
+    """(h(u), p(u), ρ(u), ρ′(u)): the support function, the support point (world frame,
+    from the centre), the radius of curvature there, ρ = tᵀ∇²h t, and its derivative
+    dρ/dφ along the boundary's normal angle. For n = 2, ρ = a²b²/h³; else, with
+    A = |a u'_x|, B = |b u'_y|, S = A^q + B^q,
     ρ = (q − 1) S^(1/q − 2) A^(q − 2) B^(q − 2) (B² a/b + A² b/a)² (from the Hessian of
-    h), infinite (returned as 1e30) on the flat points of n > 2 where A or B is 0."""
+    h), infinite (returned as 1e30, with ρ′ = 0) on the flat points of n > 2 where A or
+    B is 0."""
     a = shp[0]
     b = shp[1]
     n = shp[2]
