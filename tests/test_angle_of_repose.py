@@ -127,7 +127,9 @@ def test_cube_top_is_its_highest_vertex():
 def heaps():
     """Small wedge heaps (150 grains) of cubes, irregular polyhedra and spheres, one
     seed each."""
-    cfg = dict(ar.PRESETS["quick"], particles=150, half_base=14.0, settle_max=1.0)
+    # (a heap rests when its grains stop; the cap is only reached by a heap whose
+    # last grains still roll: the pile is chaotic, and round-off decides which)
+    cfg = dict(ar.PRESETS["quick"], particles=150, half_base=14.0, settle_max=2.5)
     # the process's thread count (the suite's workers may have started Taichi already)
     opts = {"threads": None}
     out = {}
@@ -180,7 +182,9 @@ def test_summary_schema_of_a_finished_run(heaps, tmp_path):
 def test_reanalyse_makes_the_same_summary_from_a_runs_files(heaps, tmp_path):
     # a finished run's folder (summary.json, heaps.h5 with the base forces) analysed
     # again: the same angles, pressures and checks
-    cfg = dict(ar.PRESETS["quick"], particles=150, half_base=14.0, settle_max=1.0)
+    # (a heap rests when its grains stop; the cap is only reached by a heap whose
+    # last grains still roll: the pile is chaotic, and round-off decides which)
+    cfg = dict(ar.PRESETS["quick"], particles=150, half_base=14.0, settle_max=2.5)
     runs = {("cubes", "wedge"): [heaps["cubes"]] * 3,
             ("spheres", "wedge"): [heaps["spheres"]] * 3,
             ("cubes", "layered"): [dict(heaps["cubes"], sequence="layered")] * 3}
