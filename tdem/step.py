@@ -100,7 +100,10 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         vn = vrel.dot(n)
         L = lawpair[li, plaw[j]]
         mj = pj[PROP_MASS]
-        reff = ri * rj / (ri + rj)
+        # R* = R_i R_j/(R_i + R_j) and m* = m_i m_j/(m_i + m_j) by one division
+        inv = 1.0 / ((ri + rj) * (mi + mj))
+        reff = ri * rj * (mi + mj) * inv
+        meff = mi * mj * (ri + rj) * inv
         fn_el = 0.0
         fn = 0.0
         ft = tangent_part(vrel, n) * 0.0
@@ -109,11 +112,10 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         d1 = 0.0
         if ti.static(dim == 2):
             fn_el, fn, ft, kn, cnd, d1, h = law_force(
-                laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h)
+                laws, lawp, L, u, vn, tangent_part(vrel, n), meff, reff, dt, h)
         else:
             fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
-                laws, lawp, L, u, vn, tangent_part(vrel, n), mi * mj / (mi + mj), reff, dt, h,
-                n)
+                laws, lawp, L, u, vn, tangent_part(vrel, n), meff, reff, dt, h, n)
         fs_tot = 0.0
         if ti.static(dim == 2):
             fs_tot = ft[0]
@@ -129,8 +131,10 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         else:
             fs_tot = ft.norm()
             f = -fn * n + ft
-            m_on_i = moment(ai * n, f)
-            m_on_j = moment(aj * n, f)
+            # the moments (a n) × f of the contact force at each branch: n × f = n × F_t
+            nxf = moment(n, ft)
+            m_on_i = ai * nxf
+            m_on_j = aj * nxf
             diss = d1
             if ti.static(h.n >= R + 7):
                 # rolling resistance (the columns after the law's)
