@@ -4,6 +4,8 @@
     python -m cases.report --write         # and rewrite the marked blocks of the docs
     python -m cases.report --run --write   # run every quick preset first (--threads 1)
     python -m cases.report --check         # exit 1 if the docs differ from the summaries
+    python -m cases.report --archive out/soil_cutting   # keep a run's results in docs/
+    python -m cases.report --validation    # write docs/validation.md from the kept ones
 
 The blocks it rewrites lie between HTML comments, which the Markdown does not show:
 
@@ -16,10 +18,19 @@ The blocks it rewrites lie between HTML comments, which the Markdown does not sh
 
 Text outside the markers is left as it is. The numbers are those of the summaries
 found; a case without one keeps its block and is named on stderr.
+
+The validation report. ``--archive DIR`` keeps a finished run: its ``summary.json``
+and its plots (``*.png``) are copied to ``docs/validation/CASE/PRESET/`` (the case
+and preset read from the summary), where they are committed. ``--validation``
+writes ``docs/validation.md`` from every kept run: an index (case, preset, wall time
+and where it was measured, how many checks pass, the wall-time aims of the paper
+presets) and, per run, each figure beside the paper's with its tolerance and
+verdict, and the plots.
 """
 import argparse
 import json
 import re
+import shutil
 import subprocess
 import sys
 import time
@@ -198,6 +209,97 @@ def _replace_quick_times(text, body):
     return pat.sub(lambda m: m.group(1) + body + m.group(2), text, count=1)
 
 
+# ------------------------------------------------------------ validation report
+#: where the kept runs lie (CASE/PRESET/summary.json and plots) and the report
+VALIDATION = ROOT / "docs" / "validation"
+VALIDATION_MD = ROOT / "docs" / "validation.md"
+#: wall-time aims of paper presets on 2 cores (seconds)
+PAPER_TIME_AIM = {"contact_burst": 600.0, "soil_cutting": 7200.0}
+PRESET_ORDER = ("paper", "quick")
+
+
+def archive(run_dir, root=VALIDATION):
+    """Copy a finished run's summary.json and plots to ``root/CASE/PRESET/`` (replacing
+    what was kept there); returns that folder. Refuses a folder without a summary or
+    with one that does not follow the schema, naming it."""
+    run_dir = Path(run_dir)
+    path = run_dir / "summary.json"
+    if not path.exists():
+        raise ValueError(f"--archive {run_dir}: no summary.json there (a finished run's "
+                         "output folder is needed)")
+    s = json.loads(path.read_text())
+    bad = common.validate(s)
+    if bad:
+        raise ValueError(f"--archive {run_dir}: its summary.json does not follow the "
+                         f"schema: {'; '.join(bad)}")
+    dest = Path(root) / s["case"] / s["preset"]
+    if dest.exists():
+        shutil.rmtree(dest)
+    dest.mkdir(parents=True)
+    shutil.copy2(path, dest / "summary.json")
+    for png in sorted(run_dir.glob("*.png")):
+        shutil.copy2(png, dest / png.name)
+    return dest
+
+
+def kept(root=VALIDATION):
+    """[(case, preset, summary, plot names)] of the kept runs, in table order."""
+    out = []
+    root = Path(root)
+    for case in cases():
+        for preset in PRESET_ORDER:
+            path = root / case / preset / "summary.json"
+            if path.exists():
+                s = json.loads(path.read_text())
+                plots = sorted(p.name for p in path.parent.glob("*.png"))
+                out.append((case, preset, s, plots))
+    return out
+
+
+def _aim(case, preset, s):
+    """The wall-time aim's cell: '≤ 10 min: met' etc., or '' where there is none."""
+    aim = PAPER_TIME_AIM.get(case) if preset == "paper" else None
+    if aim is None:
+        return ""
+    cores = s.get("cpu_count")
+    met = "met" if s["wall_time_s"] <= aim else "over"
+    where = f" on {cores} cores" if cores else ""
+    return f"≤ {common.duration(aim)}{where}: {met}"
+
+
+def render_validation(runs, link="validation"):
+    """The text of docs/validation.md for the kept runs ``runs`` (:func:`kept`);
+    ``link``: the kept runs' folder relative to the report."""
+    lines = ["# Validation", "",
+             "Every case's figures beside the paper's, from the runs kept in "
+             "`docs/validation/` (each run's `summary.json` and plots). Made by "
+             "`python -m cases.report --validation`; a run is kept with "
+             "`python -m cases.report --archive OUT_DIR`. The quick presets of every "
+             "case, run in the test suite's time, are in [cases.md](cases.md).", "",
+             "| case | preset | wall time | measured | checks | all pass | time aim |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
+    for case, preset, s, _ in runs:
+        n = s["counts"]
+        lines.append(f"| [`{case}`](#{case}-{preset}) | {preset} | "
+                     f"{common.duration(s['wall_time_s'])} | {_cell(how_measured([s]))} | "
+                     f"{n['passed']} of {n['passed'] + n['failed']} | {verdict(s)} | "
+                     f"{_aim(case, preset, s)} |")
+    for case, preset, s, plots in runs:
+        lines += ["", f'<a id="{case}-{preset}"></a>', "",
+                  f"## `{case}`, {preset} preset", ""]
+        if s.get("paper"):
+            what = _cell(WHAT.get(case, ""))
+            lines += [f"{what[:1].upper()}{what[1:]}; paper: {s['paper']}.", ""]
+        lines.append(render_checks(s))
+        notes = s.get("notes")
+        if notes:
+            lines += ["", f"Notes: {_cell(notes)}"]
+        if plots:
+            for p in plots:
+                lines += ["", f"![{p}]({link}/{case}/{preset}/{p})"]
+    return "\n".join(lines) + "\n"
+
+
 # ------------------------------------------------------------------ running
 def run_cases(root, names, threads=1):
     """Run the quick preset of each case into ``root/CASE`` (one after the other)."""
@@ -227,7 +329,24 @@ def main(argv=None):
                         "quick-preset times of cases/_common.py")
     p.add_argument("--check", action="store_true",
                    help="exit 1 if a marked block differs from the summaries")
+    p.add_argument("--archive", nargs="+", default=None, metavar="DIR",
+                   help="keep these finished runs (summary.json and plots) in "
+                        "docs/validation/CASE/PRESET/, then write docs/validation.md")
+    p.add_argument("--validation", action="store_true",
+                   help="write docs/validation.md from the runs kept in docs/validation/")
     args = p.parse_args(argv)
+    if args.archive or args.validation:
+        for d in args.archive or ():
+            try:
+                dest = archive(d)
+            except ValueError as e:
+                p.error(str(e))
+            print(f"report: kept {d} in {dest.relative_to(ROOT)}", file=sys.stderr)
+        runs = kept()
+        VALIDATION_MD.write_text(render_validation(runs))
+        print(f"report: wrote {VALIDATION_MD.relative_to(ROOT)} ({len(runs)} runs)",
+              file=sys.stderr)
+        return 0
     if args.run:
         names = args.cases or cases()
         unknown = [c for c in names if c not in cases()]

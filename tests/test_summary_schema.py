@@ -176,3 +176,37 @@ def test_help_gives_the_measured_quick_time():
     assert text.startswith("Wave propagation in a rock bar.\n\nquick preset: ")
     assert f"{common.QUICK_WALL_S['wave_bar']:.0f} s" in text and "2 CPU cores" in text
     assert common.duration(52.4) == "52 s" and common.duration(501) == "8.3 min"
+
+
+def test_validation_report_keeps_runs_and_lists_their_figures(tmp_path):
+    """--archive copies a run's summary and plots to CASE/PRESET; the validation
+    report lists each kept run (wall time, checks passed, the paper preset's time
+    aim) and each figure beside the paper's, and links its plots."""
+    s = _given()
+    s["preset"], s["wall_time_s"] = "paper", 5400.0
+    s["case"] = "soil_cutting"
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "summary.json").write_text(json.dumps(s))
+    (run / "fig19.png").write_bytes(b"png")
+    root = tmp_path / "validation"
+    dest = report.archive(run, root)
+    assert dest == root / "soil_cutting" / "paper"
+    assert json.loads((dest / "summary.json").read_text()) == s
+    assert (dest / "fig19.png").read_bytes() == b"png"
+    runs = report.kept(root)
+    assert [(c, p, plots) for c, p, _, plots in runs] == [("soil_cutting", "paper",
+                                                           ["fig19.png"])]
+    text = report.render_validation(runs)
+    row = [ln for ln in text.splitlines() if ln.startswith("| [`soil_cutting`]")]
+    assert row == ["| [`soil_cutting`](#soil_cutting-paper) | paper | 90 min | "
+                   "--threads 1 on 2 CPU cores, 2026-12-04 | 2 of 3 | FAIL | "
+                   "≤ 120 min on 2 cores: met |"]
+    assert report.render_check(s["checks"][3]) in text
+    assert "![fig19.png](validation/soil_cutting/paper/fig19.png)" in text
+    s["wall_time_s"] = 7300.0
+    (dest / "summary.json").write_text(json.dumps(s))
+    assert "≤ 120 min on 2 cores: over" in report.render_validation(report.kept(root))
+    # a folder without a finished run is refused, naming it
+    with pytest.raises(ValueError, match="no summary.json"):
+        report.archive(tmp_path, root)
