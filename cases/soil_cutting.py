@@ -6,7 +6,11 @@ Soil 3 m x 1 m, Mohr-Coulomb with tension cut-off (rho = 1750 kg/m3, E = 10 MPa,
 nu = 0.35, c = 10 kPa, phi = 20 deg, T = 3 kPa), PCMM particles on a square lattice
 (``tdem.pack.regular`` with the outermost centres on the edges: R = 0.01 m gives
 the paper's 151 x 51 = 7701 particles), search tolerance delta = R. The bottom row
-and the right column of particles are fixed (vx = vy = 0); gravity 9.81 m/s2.
+and the right column of particles are fixed (vx = vy = 0); gravity 9.81 m/s2. A
+floor (a frictional wall, 1.5 m long, level with the soil's base) lies left of the
+soil, under the blade: particles scraped off the free face below the cutting edge
+land there (in the paper preset one did, 1 s into the cut, and fell until it was
+taken for an instability).
 Blade (decided in the spec; the paper's Fig. 17 is not in the text): a steel plate
 (rho = 7800, E = 210 GPa, nu = 0.3) 0.6 m long and 0.04 m thick, inclined 60 deg to
 the horizontal, leaning back over the soil's left side; its cutting edge (the
@@ -151,6 +155,10 @@ def build(cfg, arch=None, threads=None):
     fixed = np.union1d(sim.particles_in(ymax=0.5 * R), sim.particles_in(xmin=W - 0.5 * R))
     sim.fix_particles(fixed, vx=0.0, vy=0.0)
 
+    # a floor left of the soil, level with its base: a particle that the blade's edge
+    # scrapes off the free face below it lands there (without it, it falls for ever)
+    sim.add_wall((-1.5, -R), (0.0, -R), contact=tdem.LinearContact(
+        kn=CONTACT_KN, ks=CONTACT_KN, friction=math.tan(math.radians(SOIL["friction_angle"]))))
     corners, u = blade_outline(R)
     v, t = tdem.mesh.polygon(corners, cfg["mesh_size"])
     blade = sim.add_block(v, t, material=tdem.Elastic(density=STEEL["density"],
