@@ -6,11 +6,12 @@ Soil 3 m x 1 m, Mohr-Coulomb with tension cut-off (rho = 1750 kg/m3, E = 10 MPa,
 nu = 0.35, c = 10 kPa, phi = 20 deg, T = 3 kPa), PCMM particles on a square lattice
 (``tdem.pack.regular`` with the outermost centres on the edges: R = 0.01 m gives
 the paper's 151 x 51 = 7701 particles), search tolerance delta = R. The bottom row
-and the right column of particles are fixed (vx = vy = 0); gravity 9.81 m/s2. A
-floor (a frictional wall, 1.5 m long, level with the soil's base) lies left of the
-soil, under the blade: particles scraped off the free face below the cutting edge
-land there (in the paper preset one did, 1 s into the cut, and fell until it was
-taken for an instability).
+and the right column of particles are fixed (vx = vy = 0); gravity 9.81 m/s2.
+Particles that leave the model (fall below the soil's base, as the blade's edge
+scrapes some off the free face below it) are held where they are found, at each
+check of the bands (``data.fallen``): the model has no floor there, and one would
+otherwise fall until its speed is taken for an instability (the paper preset lost
+one at 1 s and another at 3.5 s of cutting).
 Blade (decided in the spec; the paper's Fig. 17 is not in the text): a steel plate
 (rho = 7800, E = 210 GPa, nu = 0.3) 0.6 m long and 0.04 m thick, inclined 60 deg to
 the horizontal, leaning back over the soil's left side; its cutting edge (the
@@ -155,10 +156,6 @@ def build(cfg, arch=None, threads=None):
     fixed = np.union1d(sim.particles_in(ymax=0.5 * R), sim.particles_in(xmin=W - 0.5 * R))
     sim.fix_particles(fixed, vx=0.0, vy=0.0)
 
-    # a floor left of the soil, level with its base: a particle that the blade's edge
-    # scrapes off the free face below it lands there (without it, it falls for ever)
-    sim.add_wall((-1.5, -R), (0.0, -R), contact=tdem.LinearContact(
-        kn=CONTACT_KN, ks=CONTACT_KN, friction=math.tan(math.radians(SOIL["friction_angle"]))))
     corners, u = blade_outline(R)
     v, t = tdem.mesh.polygon(corners, cfg["mesh_size"])
     blade = sim.add_block(v, t, material=tdem.Elastic(density=STEEL["density"],
@@ -391,9 +388,15 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
         snap_times.append(T)
     checks = np.arange(cfg["check_interval"], T + 1e-9, cfg["check_interval"])
     stops = sorted(set(np.round(np.concatenate([checks, snap_times]), 9)))
+    fallen = set()
     for tc in stops:
         sim.run(until=t0 + tc)
         p = sim.particles.numpy()
+        low = [int(i) for i in np.flatnonzero(p["position"][:, 1] < -2.0 * R)
+               if int(i) not in fallen]
+        if low:
+            sim.fix_particles(low, vx=0.0, vy=0.0, omega=0.0)
+            fallen.update(low)
         tip = tip0 + speed * (sim.time - t0)
         bands = detect_bands(p, tip, R)
         band_t.append(sim.time - t0)
@@ -522,6 +525,8 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
                   "paper_equivalent_end_s": t_eq,
                   "settle_s": t0, "dt_s": dt, "point_edge_kn_N_per_m_per_m": CONTACT_KN,
                   "steps": int(round((sim.time) / dt))},
+        "fallen": {"count": len(fallen), "note": "particles that fell below the soil's base "
+                   "(off the free face under the blade), held where found"},
         "bands_final_count": len(final_bands),
         "band_formation_times_s": [first_time.get(c) for c in sorted(first_time)],
         "P1_start_m": start_P1,
