@@ -16,8 +16,9 @@ body with a non-reflecting boundary, a JWL charge, a deformable block, a rigid b
 point–edge couplings of block to block and disc to block — and a periodic pack, in two
 processes on the CPU: with ``TDEM_ADVANCED_OPTIMIZATION=0`` and ``=1``. Both must
 finish, and positions, velocities, spins, angles, plastic strains and energies agree
-to 1e-12 relative (the two builds round some floating-point operations differently;
-they agree to about 1e-16).
+to 1e-10 relative (the two builds round some floating-point operations differently:
+about 1e-16 a step, which the periodic pack's many contacts grow over the 150
+steps; measured up to 6e-12 in a spin).
 The two processes run side by side; on two cores the test takes about 85 s with an
 empty kernel cache (the build with the optimisation, mostly its step kernel with
 shaped particles and the PCMM stresses) and 20 s with Taichi's offline cache filled.
@@ -137,7 +138,7 @@ def _close(a, b, what):
     assert a.shape == b.shape, what
     assert np.isfinite(a).all() and np.isfinite(b).all(), what
     scale = np.abs(b).max() if b.size else 0.0
-    np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12 * scale, err_msg=what)
+    np.testing.assert_allclose(a, b, rtol=1e-10, atol=1e-10 * scale, err_msg=what)
 
 
 def test_kernels_build_and_agree_with_and_without_advanced_optimisation():
