@@ -10,8 +10,8 @@ and the right column of particles are fixed (vx = vy = 0); gravity 9.81 m/s2.
 Particles that leave the model (fall below the soil's base, as the blade's edge
 scrapes some off the free face below it) are held where they are found, at each
 check of the bands (``data.fallen``): the model has no floor there, and one would
-otherwise fall until its speed is taken for an instability (the paper preset lost
-one at 1 s and another at 3.5 s of cutting).
+otherwise fall until its speed is taken for an instability (a paper-preset run lost
+one 1 s into the cut this way).
 Blade (decided in the spec; the paper's Fig. 17 is not in the text): a steel plate
 (rho = 7800, E = 210 GPa, nu = 0.3) 0.6 m long and 0.04 m thick, inclined 60 deg to
 the horizontal, leaning back over the soil's left side; its cutting edge (the
@@ -47,8 +47,9 @@ Presets
   under the cutting loads its deflection is negligible beside the soil's, while its
   elastic waves would set the time step at 4.5e-7 s, 165 times shorter than the
   soil's 7.4e-5 s (the estimate for the elastic blade was 455 hours on 2 cores;
-  rigid, the run takes about an hour, docs/cases.md). ``--elastic-blade`` gives the spec's elastic plate
-  whose left-side nodes (the upper, back end) are driven; runnable, very long.
+  rigid, the run takes about an hour, docs/cases.md). ``--elastic-blade`` gives the
+  spec's elastic plate whose left-side nodes (the upper, back end) are driven;
+  runnable, very long.
 - ``quick`` (its measured time: --help): R = 0.025 m (61 x 21 = 1281
   particles), a kinematic rigid blade (every node prescribed, so the steel does
   not limit the time step), a blade 5 x faster (0.5 m/s) and 1.2 s of cutting

@@ -25,7 +25,7 @@ from physics.rolling import (rolling_couple, rolling_couple_3d, rolling_energy,
                              rolling_energy_3d)
 
 from .finite import any_non_finite, non_finite
-from .integrate import damped_leapfrog, free_rotation
+from .integrate import _quat_mul, damped_leapfrog, free_rotation
 from .launch import cached
 from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY,  # noqa: F401
                         P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0, P_PZ0, P_SKIN,
@@ -785,11 +785,7 @@ def turn_quaternion(q, phi):
         a = ti.sqrt(a2)
         c = ti.cos(0.5 * a)
         s = ti.sin(0.5 * a) / a
-    dq = ti.Vector([c, s * phi[0], s * phi[1], s * phi[2]])
-    r = ti.Vector([dq[0] * q[0] - dq[1] * q[1] - dq[2] * q[2] - dq[3] * q[3],
-                   dq[0] * q[1] + dq[1] * q[0] + dq[2] * q[3] - dq[3] * q[2],
-                   dq[0] * q[2] - dq[1] * q[3] + dq[2] * q[0] + dq[3] * q[1],
-                   dq[0] * q[3] + dq[1] * q[2] - dq[2] * q[1] + dq[3] * q[0]])
+    r = _quat_mul(ti.Vector([c, s * phi[0], s * phi[1], s * phi[2]]), q)
     # |r|² = 1 + e with e at round-off (q and dq are unit): 1/|r| = 1 − e/2 to
     # round-off; a larger e (a quaternion given off unit) is divided out exactly
     e = r.dot(r) - 1.0
