@@ -351,6 +351,37 @@ class Fluid(Material):
     Moyce's experiment: about 0.9 m) and loses less energy. Both lose volume
     when a random packing flows (the area of deleted triangles is not
     returned to anyone), so water is best packed on a lattice.
+
+    Packings other than the square lattice, measured (0.3 × 0.5 m column, R = 5
+    mm, K = ρ(10·sqrt(2gh))² = 0.98 MPa, μ = 1 Pa·s, frictionless walls, local
+    damping 0.7, released at zero pressure, 1 s):
+
+    - hexagonal lattice (``tdem.pack.cross``), incremental pressure: the particle
+      pressures' median is ρgd but single particles read −0.07 to 2.2 × ρgd
+      (the triangles' pressures alternate by about ±ρgd between the up and the
+      down triangles, a pattern that pushes no particle), the largest speed stays
+      at 0.006–0.03 m/s and the lattice rearranges (7 % more elements after 1 s).
+      The release excites the first sloshing mode of the tank, which local
+      damping hardly damps, and the G = 0 triangles (two area constraints per
+      particle, as many as its degrees of freedom) give way along zero-energy
+      modes. With ``equation_of_state`` the particles at the walls speed up to
+      0.6 m/s. A deviatoric stiffness 2G_s·dev(Δε_e − Δε̄) against each
+      triangle's departure from the strain of its neighbourhood (G_s = 0.05 K;
+      tried, not offered) holds the column at rest (1e-4 m/s) with pressures of
+      0.92–0.99 × ρgd, and blows up on a random packing.
+    - random packings: the overlapping triangles of neighbouring particles' rings
+      do not tile the body, so a uniform pressure p pushes interior particles by
+      up to 3 R × p per metre (tests/test_fluid.py,
+      ``test_lattice_element_systems_are_conformal``): under ρgd, about d/R
+      times a particle's weight. Water there does not come to rest.
+
+    What would hold on any packing is an element system that tiles (a Delaunay
+    triangulation of the centres within the Eq. 1 distance, kept by edge flips)
+    with a pressure stabilised against both the checkerboard and the zero-energy
+    modes. On a fixed tiling of the hexagonal column, the particle pressure of
+    ``equation_of_state`` with mass-proportional damping (30 /s) reads 0.95–1.00
+    × ρgd, and only the particles where the free surface meets the walls still
+    move (0.03–0.08 m/s).
     """
 
     _ARGS = ("density", "bulk_modulus", "viscosity", "linear_viscosity",
