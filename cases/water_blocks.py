@@ -117,6 +117,7 @@ displacement histories (``histories.h5``, ``block_displacements.png``),
 """
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -131,6 +132,7 @@ GAP_TO_BLOCKS = 1.15
 BLOCK = 0.1
 ROWS = 6
 COLUMN_GAP = 1e-3
+FRICTION = 25.0          # block-block and block-floor friction angle (degrees), the spec's
 RHO_W = 1000.0
 CONCRETE = {"density": 2400.0, "young": 30e9, "poisson": 0.2}
 BLOCK_KN = 3e8
@@ -161,10 +163,11 @@ def water_particles(cfg):
     return tdem.pack.random(WATER_W, WATER_H, rmin, rmax, seed=1, target_fraction=frac)
 
 
-def block_layout(columns):
-    """Lower-left corners of the blocks, column by column, bottom to top."""
+def block_layout(columns, gap=COLUMN_GAP):
+    """Lower-left corners of the blocks, column by column, bottom to top; ``gap``
+    between columns (m)."""
     x0 = WATER_W + GAP_TO_BLOCKS
-    return [(x0 + c * (BLOCK + COLUMN_GAP), r * BLOCK) for c in range(columns)
+    return [(x0 + c * (BLOCK + gap), r * BLOCK) for c in range(columns)
             for r in range(ROWS)]
 
 
@@ -198,17 +201,21 @@ def build(cfg, columns, arch=None, threads=None):
         e.fix(np.arange(len(ev)), vx=0.0, vy=0.0)
         ends.append(e)
     blocks = []
-    for (x, y) in block_layout(columns):
+    gap = cfg.get("column_gap", COLUMN_GAP)
+    for (x, y) in block_layout(columns, gap):
         v, t = square(x, y)
         blocks.append(sim.add_block(v, t, material=concrete, rigid=True))
     ks = BLOCK_KN / (2.0 * (1.0 + CONCRETE["poisson"]))
-    bb = tdem.PointEdge(kn=cfg.get("block_kn", BLOCK_KN), ks=ks, friction_angle=25.0, cohesion=0.0,
-                        tensile_strength=0.0)
+    kn = cfg.get("block_kn", BLOCK_KN)
+    bb = tdem.PointEdge(kn=kn, ks=ks, friction_angle=cfg.get("block_friction", FRICTION),
+                        cohesion=0.0, tensile_strength=0.0)
+    bf = tdem.PointEdge(kn=kn, ks=ks, friction_angle=cfg.get("floor_friction", FRICTION),
+                        cohesion=0.0, tensile_strength=0.0)
     wb = tdem.PointEdge(kn=cfg.get("water_block_kn", 3.0 * cfg["bulk"]), ks=0.0,
                         friction_angle=0.0)
-    corners = block_layout(columns)
+    corners = block_layout(columns, gap)
     for k, b in enumerate(blocks):
-        sim.couple(b, floor, bb)
+        sim.couple(b, floor, bf)
         for e in ends:
             sim.couple(b, e, bb)
         sim.couple(g, b, wb)
@@ -299,7 +306,9 @@ def plot_displacements(results, png):
     common.save(fig, png, dpi=120)
 
 
-def run_one(cfg, columns, name, out, arch=None, threads=None):
+def run_one(cfg, columns, name, out, arch=None, threads=None, folder=None):
+    """One run: ``name`` "four" or "two" (the paper's snapshot times); output in
+    ``out/folder`` (default ``out/name``)."""
     m = build(cfg, columns, arch=arch, threads=threads)
     sim, blocks, board = m["sim"], m["blocks"], m["board"]
     t0 = cfg["settle"]
@@ -309,7 +318,7 @@ def run_one(cfg, columns, name, out, arch=None, threads=None):
     top = blocks[-1]             # top block of the rightmost column
     c_ref, a_ref = block_state(top)
     refs = [block_state(b)[0] for b in blocks]
-    sub = out / name
+    sub = out / (folder or name)
     sub.mkdir(parents=True, exist_ok=True)
     output = common.start_output(sim, sub, max(1, int(round(cfg["vtu_interval"] / sim.dt))))
     T = cfg["duration"]
@@ -441,8 +450,167 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
     return summary
 
 
+# ------------------------------------------------------------------ the sweep
+#: the parameters the paper does not give, and the values the sweep tries (four columns)
+SWEEP = {"floor_friction": (25.0, 35.0, 45.0), "block_friction": (25.0, 45.0),
+         "column_gap": (0.001, 0.01)}
+
+
+def sweep_tasks(preset="quick", arch=None, grid=None):
+    """One task per combination of ``grid`` (default :data:`SWEEP`), four columns."""
+    grid = SWEEP if grid is None else grid
+    for name, values in grid.items():
+        if name not in SWEEP:
+            raise ValueError(f"grid: unknown parameter {name!r} (known: {', '.join(SWEEP)})")
+        if not values:
+            raise ValueError(f"grid: {name} has no values")
+    keys = list(grid)
+    combos = [[]]
+    for k in keys:
+        combos = [c + [float(v)] for c in combos for v in grid[k]]
+    return [dict(zip(keys, c), preset=preset, arch=arch) for c in combos]
+
+
+def task_name(task):
+    return "floor{:g}_block{:g}_gap{:g}mm".format(
+        task.get("floor_friction", FRICTION), task.get("block_friction", FRICTION),
+        1e3 * task.get("column_gap", COLUMN_GAP))
+
+
+def sweep_task(task, out):
+    """Run the four-column system with the task's parameters; returns its row."""
+    clock = common.Stopwatch()
+    cfg = dict(PRESETS[task["preset"]])
+    cfg["vtu_interval"] = cfg["duration"]           # the first and the last state only
+    for k in SWEEP:
+        if k in task:
+            cfg[k] = task[k]
+    r = run_one(cfg, 4, "four", Path(out), arch=task.get("arch"), threads=1,
+                folder=task_name(task))
+    dxm = float(np.max(np.abs(r["dx_top"]))) if len(r["dx_top"]) else float("nan")
+    rotm = float(np.max(np.abs(r["rot_top"]))) if len(r["rot_top"]) else float("nan")
+    moving = np.flatnonzero(np.abs(r["dx_top"]) > 0.005)
+    dx_all = np.asarray(r["dx_all"])
+    return {**{k: task.get(k, d) for k, d in (("floor_friction", FRICTION),
+                                             ("block_friction", FRICTION),
+                                             ("column_gap", COLUMN_GAP))},
+            "outcome": classify(dxm, rotm), "top_dx_max_m": dxm, "top_rotation_max_deg": rotm,
+            "onset_s": float(r["t"][moving[0]]) if len(moving) else None,
+            "columns_moved_0p1m": int(np.sum(np.max(np.abs(dx_all), axis=0).reshape(4, ROWS)
+                                              .max(axis=1) > TOPPLED_DX)) if len(dx_all) else 0,
+            "status": r["status"], "wall_s": clock(),
+            "t": [float(v) for v in r["t"]], "dx_top": [float(v) for v in r["dx_top"]]}
+
+
+def sweep_table(rows):
+    """The rows as a Markdown table (docs and the summary's notes)."""
+    lines = ["| floor friction | block friction | column gap | outcome | top block: largest "
+             "dx | largest rotation | moves 5 mm at | columns moved > 0.1 m |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for r in rows:
+        onset = "–" if r["onset_s"] is None else f"{r['onset_s']:.2f} s"
+        lines.append(f"| {r['floor_friction']:g}° | {r['block_friction']:g}° | "
+                     f"{1e3 * r['column_gap']:g} mm | {r['outcome']} | "
+                     f"{r['top_dx_max_m']:.3f} m | {r['top_rotation_max_deg']:.1f}° | {onset} | "
+                     f"{r['columns_moved_0p1m']} of 4 |")
+    return "\n".join(lines) + "\n"
+
+
+def run_sweep(tasks, out, workers=2, scheduler=None):
+    """Run ``tasks`` on Dask (a ``distributed.LocalCluster`` of ``workers`` processes
+    with one thread each, or the cluster at ``scheduler``), printing each run as it
+    ends; returns the rows in task order."""
+    from cases.biaxial import dask_distributed
+    Client, LocalCluster = dask_distributed()
+    from distributed import as_completed
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                               dashboard_address=None, env={"TDEM_THREADS": "1"})
+        client = Client(cluster)
+    else:
+        client = Client(scheduler)
+    try:
+        futures = [client.submit(sweep_task, t, str(out), pure=False) for t in tasks]
+        index = {f.key: k for k, f in enumerate(futures)}
+        rows = [None] * len(tasks)
+        for done, f in enumerate(as_completed(futures), 1):
+            r = f.result()
+            rows[index[f.key]] = r
+            print(f"water_blocks sweep: {done}/{len(tasks)} {task_name(r)}: {r['outcome']} "
+                  f"(dx {r['top_dx_max_m']:.3f} m, rotation {r['top_rotation_max_deg']:.1f}°, "
+                  f"{r['wall_s'] / 60:.1f} min)", flush=True)
+        return rows
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def plot_sweep(rows, png):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    gaps = sorted({r["column_gap"] for r in rows})
+    floors = sorted({r["floor_friction"] for r in rows})
+    fig, axes = plt.subplots(1, len(gaps), figsize=(6.5 * len(gaps), 4.8), squeeze=False,
+                             sharey=True)
+    colours = plt.cm.viridis(np.linspace(0.0, 0.85, len(floors)))
+    for ax, gap in zip(axes[0], gaps):
+        for r in rows:
+            if r["column_gap"] != gap:
+                continue
+            c = colours[floors.index(r["floor_friction"])]
+            ls = "-" if r["block_friction"] == min(x["block_friction"] for x in rows) else "--"
+            ax.plot(r["t"], r["dx_top"], ls, color=c,
+                    label=f"floor {r['floor_friction']:g}°, blocks {r['block_friction']:g}°: "
+                          f"{r['outcome']}")
+        ax.axhline(TOPPLED_DX, color="grey", lw=0.8, ls=":")
+        ax.set_title(f"four columns, {1e3 * gap:g} mm apart")
+        ax.set_xlabel("time after the board's removal (s)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    axes[0][0].set_ylabel("top block of the right column: dx (m)")
+    fig.suptitle("water_blocks: the parameters the paper does not give (paper: four columns "
+                 "stand)")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+
+
+def _extra(p):
+    p.add_argument("--sweep", action="store_true",
+                   help="four columns over the parameters the paper does not give (floor "
+                        "and block friction, column gap; cases.water_blocks.SWEEP) at the "
+                        "preset's resolution, on Dask")
+    p.add_argument("--workers", type=int, default=2,
+                   help="with --sweep: worker processes of the local cluster (default 2)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="with --sweep: address of an existing Dask scheduler")
+
+
+def main_sweep(args, out):
+    import json
+    if args.workers < 1:
+        raise SystemExit(f"--workers must be >= 1, got {args.workers}")
+    tasks = sweep_tasks(args.preset, args.arch)
+    print(f"water_blocks sweep ({args.preset}): {len(tasks)} runs of four columns on "
+          f"{args.scheduler or f'{args.workers} local workers'}", flush=True)
+    rows = run_sweep(tasks, out, workers=args.workers, scheduler=args.scheduler)
+    (out / "sweep.json").write_text(json.dumps(
+        [{k: v for k, v in r.items() if k not in ("t", "dx_top")} for r in rows], indent=1))
+    table = sweep_table(rows)
+    (out / "sweep.md").write_text(table)
+    plot_sweep(rows, out / "sweep.png")
+    print(table)
+    print(f"sweep: {out / 'sweep.md'}, {out / 'sweep.png'}")
+    return 0
+
+
 def main(argv=None):
-    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
+    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
+    if args.sweep:
+        return main_sweep(args, out)
     s = run(args.preset, out, arch=args.arch, threads=args.threads)
     common.print_checks(s)
     print(f"summary: {out / 'summary.json'}")
