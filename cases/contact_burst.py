@@ -180,8 +180,11 @@ def crater_size(centres, height, level, centre, tol, bridge=2, floor=5):
         hi += 1
 
     def crossing(a, b):
-        """x where the profile passes level − tol between columns a (below) and b."""
+        """x where the profile passes level − tol between columns a (below) and b;
+        the border between them where a is empty (no surface to interpolate from)."""
         ya, yb = height[a] - (level - tol), height[b] - (level - tol)
+        if not np.isfinite(ya):
+            return 0.5 * (centres[a] + centres[b])
         if not np.isfinite(yb) or yb == ya:
             return centres[b]
         return centres[a] + (centres[b] - centres[a]) * ya / (ya - yb)

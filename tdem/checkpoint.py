@@ -591,6 +591,9 @@ def load(path, arch=None):
             arr = sim._cont.a.get(k)
             if arr is None:
                 continue
+            if k == "pjwl" and v.ndim == 2 and v.shape[1] == 5:
+                # files written before the pending volume change (column 5) was kept
+                v = np.concatenate([v, np.zeros((len(v), 1))], axis=1)
             if tuple(arr.shape) != v.shape[:len(arr.shape)]:
                 raise InputError(f"path: checkpoint {str(path)!r} is damaged: "
                                  f"'/continuum/{k}' has shape {v.shape}, expected "

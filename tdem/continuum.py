@@ -146,7 +146,7 @@ class Continuum:
         a["pstate"] = _arr(4, (n,))
         # JWL particles: relative volume V, energy E per initial volume, lighting time,
         # pressure, initial volume m/ρ0 (physics.materials.JWL)
-        a["pjwl"] = _arr(5, (n,))
+        a["pjwl"] = _arr(6, (n,))
         self._init_jwl(pmat)
         a["xforce"] = _arr(2, (n,))
         a["pinc"] = ti.ndarray(ti.i32, (n, pcmm.MAX_INCIDENT))
@@ -180,8 +180,9 @@ class Continuum:
 
     # ------------------------------------------------------------------ set-up
     def _init_jwl(self, pmat):
-        """V = 1, E = E0, never lit (t_l = +inf), p = 0, V0 = m/ρ0 for JWL particles."""
-        st = np.zeros((max(self.n, 1), 5))
+        """V = 1, E = E0, never lit (t_l = +inf), p = 0, V0 = m/ρ0 for JWL particles,
+        no volume change pending."""
+        st = np.zeros((max(self.n, 1), 6))
         st[:, 0] = 1.0
         st[:, 2] = np.inf
         st[:, 4] = 1.0
@@ -208,8 +209,10 @@ class Continuum:
 
     def jwl_state(self):
         """Per-particle JWL state: relative volume, energy per initial volume,
-        lighting time, pressure, initial volume (N, 5); rows of non-JWL particles are
-        unused."""
+        lighting time, pressure, initial volume, and the volume change of the last
+        step by the elements that pushed over it (N, 6; :func:`physics.pcmm.volumes`);
+        rows of non-JWL particles are unused (the Fluid equation of state uses
+        columns 0, 3, 4 and 5)."""
         return self.a["pjwl"].to_numpy()[:self.n]
 
     def _initial_elements(self, pos, rad, pmat):
@@ -535,6 +538,13 @@ class Continuum:
         pcmm.update(a, e, float(dt), float(sim._time), int(sim.steps == 0),
                     self._full or sim.steps <= 1, self.carry_stress, self.eos, sim._serial())
         self._full = False
+
+    def eos_volumes(self, sim, dt):
+        """Stage, after the particles moved: each particle with an equation of state
+        keeps the volume change of the step by the elements that pushed over it
+        (physics.pcmm.volumes), for the next step's update."""
+        if self.has_pcmm and self.eos:
+            pcmm.volumes(self.a, sim._a, float(dt), sim._serial())
 
     def block_stresses(self, sim, dt):
         """Stage: block triangles' stresses and their nodal forces into ``nforce``."""

@@ -591,7 +591,9 @@ class Runner:
         6. viscous (non-reflecting) boundaries — ``xforce``, ``nforce``;
         7. DEM pairs and walls, gathered with ``xforce``, and the particles' damped
            leapfrog (tdem.step, one kernel) — particle state, contacts, walls;
-        8. block nodes and rigid blocks integrated (tdem.integrate) — node state.
+        8. block nodes and rigid blocks integrated (tdem.integrate) — node state;
+        9. the volume change of the step of particles with an equation of state, by
+           the elements that pushed over it (physics.pcmm.volumes) — ``pjwl``.
         """
         cont = self._cont
         dt = self._dt_run
@@ -615,6 +617,7 @@ class Runner:
                        self._shape_code, self.dim)
         if cont is not None:
             cont.integrate(self)
+            cont.eos_volumes(self, dt)
         self._time += dt
         self._steps += 1
 

@@ -1,6 +1,7 @@
 """contact_burst (Feng et al. §4.2): a TNT disc on soft rock. The quick preset's
 first millisecond (the blast wave's passage below the charge and along the
 surface) against the paper's Figs. 23-24; the whole 3.6 ms in the slow test."""
+import numpy as np
 import pytest
 
 from cases import _common as common
@@ -85,7 +86,6 @@ def _synthetic_surface(width, depth, R=0.02, W=4.0, H=2.0, ejecta=True):
     """Discs on a square lattice filling the rock below y = H except a parabolic
     crater (width at the top, depth) at x = W/2, and a cloud of ejecta above the
     crater with a gap below it."""
-    import numpy as np
     xs = np.arange(R, W, 2 * R)
     ys = np.arange(R, H, 2 * R)
     X, Y = np.meshgrid(xs, ys)
@@ -132,5 +132,30 @@ def test_crater_measure_on_a_synthetic_surface(width, depth):
     assert d == pytest.approx(depth, abs=2 * R)
     x, r = _synthetic_surface(width, depth, R, ejecta=False)
     x = x[x[:, 1] < 2.0 - 2 * depth]                # a flat rock, lower
+    xs, top = contact_burst.surface_profile(x, r, 0.0, 4.0, 2 * R)
+    assert contact_burst.crater_size(xs, top, top.max(), 2.0, R) == (0.0, 0.0)
+
+
+def test_crater_edge_at_an_empty_column():
+    """A column emptied to the bottom (every disc thrown out) at the crater's edge:
+    the crossing is taken at the border of the empty column, not interpolated from
+    −inf (which gave a NaN width). Flat surface at 2 m, columns of 4 cm, the crater
+    0.4 m deep over x = 1.8–2.2 m, its left edge column empty."""
+    xs = np.arange(0.02, 4.0, 0.04)
+    top = np.full(len(xs), 2.0)
+    inside = (xs > 1.8) & (xs < 2.2)
+    top[inside] = 1.6
+    top[np.flatnonzero(inside)[0]] = -np.inf
+    w, d = contact_burst.crater_size(xs, top, 2.0, 2.0, 0.02)
+    # left: the border of the empty column (1.80); right: between 2.18 (below)
+    # and 2.22 (at 2.0), where the profile crosses 1.98: 2.18 + 0.04·0.38/0.4
+    assert w == pytest.approx(2.218 - 1.80, abs=1e-9)
+    assert d == pytest.approx(0.4, abs=1e-9)
+
+
+def test_intact_surface_has_no_crater():
+    R = 0.02
+    x, r = _synthetic_surface(1.4, 0.35, R, ejecta=False)
+    x = x[x[:, 1] < 2.0 - 2 * 0.35]                 # a flat rock, lower
     xs, top = contact_burst.surface_profile(x, r, 0.0, 4.0, 2 * R)
     assert contact_burst.crater_size(xs, top, top.max(), 2.0, R) == (0.0, 0.0)

@@ -117,9 +117,10 @@ from .system import (F_NEED, F_OVER, FLAGS_SIZE, MAX_CAPACITY, ElementSystem, bi
 from .rebuild import (EPOCH_REBUILT, EPOCH_RECOUNT, REBUILT_CHANGED, REBUILT_SAME, SLACK_FLOOR,
                       candidates, copies, displacements, incidence, mark_dirty, rebuild_elements,
                       record_slots, sync_copies)
-from .stress import LOW32, bulk_viscosity, equation_of_state, stresses, viscous_stress
+from .stress import (LOW32, bulk_viscosity, eos_volumes, equation_of_state, stresses,
+                     viscous_stress)
 from .nodal import CARRIED, FLUID_CORE, fluid_core_force, gather
-from .step import update
+from .step import update, volumes
 
 __all__ = [
     # layout
@@ -135,7 +136,8 @@ __all__ = [
     "record_slots", "incidence", "EPOCH_REBUILT", "EPOCH_RECOUNT", "REBUILT_CHANGED",
     "REBUILT_SAME", "SLACK_FLOOR",
     # stresses
-    "stresses", "equation_of_state", "bulk_viscosity", "viscous_stress", "LOW32",
+    "stresses", "equation_of_state", "eos_volumes", "bulk_viscosity", "viscous_stress",
+    "LOW32",
     # gather and the step
-    "gather", "fluid_core_force", "FLUID_CORE", "CARRIED", "update",
+    "gather", "fluid_core_force", "FLUID_CORE", "CARRIED", "update", "volumes",
 ]

@@ -6,7 +6,7 @@ The stages are the kernels of :mod:`physics.pcmm.rebuild` (0–1d),
 """
 from .nodal import gather
 from .rebuild import copies, displacements, incidence, mark_dirty, rebuild_elements, record_slots
-from .stress import equation_of_state, stresses
+from .stress import eos_volumes, equation_of_state, stresses
 
 
 def update(a, e, dt, time, first, full, carry, eos, serial):
@@ -45,9 +45,18 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     if eos:
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["sigc"],
-                          a["efor"], a["eidx"], a["ede"], a["pjwl"], dt, time, serial)
+                          a["efor"], a["eidx"], a["ede"], a["pjwl"], dt, time, first, serial)
     gather(e["pos"], a["rad"], a["pmat"], a["matp"], a["nbr"], a["ncnt"], a["elem"],
            a["pinc"], a["picnt"], a["piwt"], a["efor"], a["eidx"], a["psig"], a["peps"],
            a["pstate"],
            a["xforce"], a["pjwl"], e["nbr"], e["ncnt"], e["cskip"], e["hist"], e["prop"],
            a["pdirty"], a["pflags"], int(first), eos, serial)
+
+
+def volumes(a, e, dt, serial):
+    """The end of a step (the particles at x_{n+1}, moving at v_{n+1/2}): the volume
+    change of each particle with an equation of state by the elements that pushed
+    over the step (:func:`physics.pcmm.stress.eos_volumes`), kept for the next
+    step's update."""
+    eos_volumes(a["pmat"], a["matp"], e["pos"], e["vel"], a["elem"], a["emult"],
+                a["pinc"], a["picnt"], a["ncov"], a["pjwl"], dt, serial)

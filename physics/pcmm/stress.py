@@ -14,8 +14,9 @@ import taichi as ti
 from tdem.launch import cached
 
 from .. import fvm
-from ..materials import (FLUID, JWL_D, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS, MAT_G, MAT_K, MAT_RHO,
-                         MAT_TYPE, MAT_VISC, fluid_pressure, jwl_pressure, mc_correct_state)
+from ..materials import (FLUID, JWL_D, JWL_OMEGA, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS, MAT_G,
+                         MAT_K, MAT_RHO, MAT_TYPE, MAT_VISC, fluid_pressure, jwl_pressure,
+                         mc_correct_state)
 from .layout import P_NEW, P_RECOUNT, P_SOFT
 from .rebuild import SLACK_FLOOR
 from .rules import _cover_incident, _sorted3
@@ -257,15 +258,22 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                       sigc: ti.types.ndarray(), efor: ti.types.ndarray(),
                       eidx: ti.types.ndarray(),
                       ede: ti.types.ndarray(), pjwl: ti.types.ndarray(), dt: ti.f64,
-                      time: ti.f64, serial: ti.template()):
+                      time: ti.f64, first: ti.i32, serial: ti.template()):
     """2j. Particles with an equation of state (JWL, or a Fluid with
     ``equation_of_state``): the state at x_n. A particle's volume changes by a third
-    of Σ_e (S_e/N_e) Δθ_e over its elements (so that Σ_i p_i ΔVol_i is the elements'
-    pressure work exactly). JWL: its energy changes by −(p + q) ΔVol with the p its
-    elements pushed with over that change (last step's, so that the energy lost is
-    exactly the work the forces did), p = F·p_JWL(V, E) with F the programmed burn
-    fraction. Fluid: p(V) of :class:`physics.materials.Fluid` (a state function:
-    deleting or creating elements does not change it).
+    of the mean of two sums of (S_e/N_e) ΔS_e, ΔS_e the area change of the last step:
+    over this step's elements (Δθ_e of the stress pass) and over the elements that
+    pushed over the last step (:func:`eos_volumes`, kept in column 5); where an
+    element was created or deleted by the rules between the two, or its N_e
+    changed, the two differ. The mean, with the energy change below, keeps kinetic
+    (at half steps) plus internal energy: the half-step kinetic energy takes the
+    work of each step's forces over half of the motion before and half of the
+    motion after them. JWL: the energy changes by −(p̄ + q) ΔVol, p̄ the mean of
+    the pressures before and after the change (implicit in the energy, solved in
+    closed form: p_JWL is linear in E), p = F·p_JWL(V, E) with F the programmed
+    burn fraction. Fluid: p(V) of :class:`physics.materials.Fluid` (a state
+    function: deleting or creating elements does not change it). At a run's first
+    step there is no last step's set: this step's sums alone.
     2k. Their elements: the mean pressure of their particles, the viscous stress
     2μ·dev(D) (Fluid) and the artificial bulk viscosity q (forces only)."""
     n = pmat.shape[0]
@@ -286,16 +294,22 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                     qsum += mw * d[5] * d[6]
                 js = pjwl[i]
                 V0 = js[4]
-                V = js[0] + thsum / (3.0 * V0)
+                if first == 0:
+                    thsum = 0.5 * (thsum + js[5])
+                dv = thsum / (3.0 * V0)
+                V = js[0] + dv
                 if ti.cast(matp[M, MAT_TYPE], ti.i32) == JWL_TYPE:
                     F = 0.0
                     if time >= js[2]:
                         F = ti.min(1.0, (time - js[2]) * matp[M, JWL_D] / (3.0 * rad[i]))
-                    E = js[1] - (js[3] * thsum + qsum) / (3.0 * V0)
+                    # E' = E − (½(p + F·p_JWL(V', E')) + q) ΔV, p_JWL = a(V) + ω E / V
+                    a0 = F * jwl_pressure(matp, M, V, 0.0)
+                    E = ((js[1] - 0.5 * (js[3] + a0) * dv - qsum / (3.0 * V0))
+                         / (1.0 + 0.5 * F * matp[M, JWL_OMEGA] * dv / V))
                     p = F * jwl_pressure(matp, M, V, E)
-                    pjwl[i] = ti.Vector([V, E, js[2], p, V0])
+                    pjwl[i] = ti.Vector([V, E, js[2], p, V0, js[5]])
                 else:
-                    pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), V0])
+                    pjwl[i] = ti.Vector([V, js[1], js[2], fluid_pressure(matp, M, V), V0, js[5]])
     ti.loop_config(serialize=serial)
     for a in range(n):
         for s in range(ecnt[a]):
@@ -315,6 +329,36 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                     sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
                     _record(efor, eidx[a, s], sig, sf, 1.0 / ncov[a, s], de, d[3],
                             ti.cast(d[4], ti.i32), emult[a, s], b, c)
+
+
+@cached
+@ti.kernel
+def eos_volumes(pmat: ti.types.ndarray(), matp: ti.types.ndarray(), pos: ti.types.ndarray(),
+                vel: ti.types.ndarray(), elem: ti.types.ndarray(), emult: ti.types.ndarray(),
+                inc: ti.types.ndarray(), icnt: ti.types.ndarray(), ncov: ti.types.ndarray(),
+                pjwl: ti.types.ndarray(), dt: ti.f64, serial: ti.template()):
+    """The end of a step: for each particle with an equation of state, Σ_e (S_e/N_e)
+    ΔS_e over the elements containing it that pushed over the step (their weights
+    as the forces had them), ΔS_e = S_e(x_{n+1}) − S_e(x_{n+1} − Δt·v_{n+1/2})
+    exactly; kept in column 5 of ``pjwl`` for :func:`equation_of_state`."""
+    ti.loop_config(serialize=serial)
+    for i in range(pmat.shape[0]):
+        M = pmat[i]
+        if M >= 0:
+            if _has_eos(matp, M):
+                acc = 0.0
+                for k in range(icnt[i]):
+                    code = inc[i, k]
+                    o = code >> 6
+                    sl = (code >> 2) & 15
+                    b = elem[o, sl, 0]
+                    c = elem[o, sl, 1]
+                    xa, xb, xc = pos[o], pos[b], pos[c]
+                    da = fvm.area(xa, xb, xc) - fvm.area(xa - dt * vel[o], xb - dt * vel[b],
+                                                         xc - dt * vel[c])
+                    acc += ti.cast(emult[o, sl], ti.f64) / ncov[o, sl] * da
+                js = pjwl[i]
+                pjwl[i] = ti.Vector([js[0], js[1], js[2], js[3], js[4], acc])
 
 
 @ti.func
