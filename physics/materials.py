@@ -317,9 +317,11 @@ class Fluid(Material):
         element carries its own stress from step to step; a new element starts
         from the mean of its particles' stresses). True: the pressure is a state
         of the particles, p = max(K·(1/V − 1), −tensile_strength), V the relative
-        volume each particle carries (changed by a third of Σ_e (S_e/N_e)·Δθ_e
+        volume each particle carries (changed by a third of Σ_e (S_e/N_e)·ΔS_e
         over the elements containing it, divided by its initial volume M_i/ρ0:
-        the JWL bookkeeping of :mod:`physics.pcmm`); an element pushes with the
+        the JWL bookkeeping of :func:`physics.pcmm.equation_of_state`, the mean
+        of that sum over the step's elements and over those that pushed over
+        it); an element pushes with the
         mean pressure of its three particles, plus the viscous stress and q.
 
     Contacts between water particles. Two particles of one Fluid body that are
@@ -430,8 +432,9 @@ class JWL(Material):
         p = A (1 − ω/(R1 V)) e^(−R1 V) + B (1 − ω/(R2 V)) e^(−R2 V) + ω E/V,
 
     V = ρ0/ρ the relative volume and E the internal energy per unit initial volume
-    (Pa), both tracked per particle (:func:`physics.pcmm.update`): V from the volume
-    changes of its elements, dE = −(p + q) dV with q the artificial bulk viscosity.
+    (Pa), both tracked per particle (:func:`physics.pcmm.equation_of_state`): V from
+    the volume changes of its elements, dE = −(p + q) dV with q the artificial bulk
+    viscosity and p the mean of the pressures before and after the step's change.
     G = 0: a particle's stress is −p·I.
 
     Programmed burn: :meth:`tdem.Simulation.detonate` gives each particle its
