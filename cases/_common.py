@@ -6,6 +6,7 @@ line of its docstring is its one-line description (``tdem list``).
 """
 import argparse
 import ast
+import contextlib
 import json
 import math
 import pkgutil
@@ -642,3 +643,39 @@ def list_cases():
             found[mod.name] = desc
     return found
 
+
+
+# ----------------------------------------------------------------- Dask sweeps
+SWEEP_INSTALL = 'pip install "tdem[sweep]"'
+
+
+def dask_distributed():
+    """(Client, LocalCluster) of ``distributed``, imported on first use: Dask is an
+    optional extra of tdem. ImportError naming the install command when it is missing."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError as e:
+        raise ImportError(f"the sweep runs on Dask (dask.distributed), which is not "
+                          f"installed: {SWEEP_INSTALL} (or pip install "
+                          f'"dask[distributed]") ({e})') from None
+    return Client, LocalCluster
+
+
+@contextlib.contextmanager
+def dask_client(scheduler=None, workers=2):
+    """A Dask client of the cluster at ``scheduler``, or of a ``distributed.LocalCluster``
+    of ``workers`` processes with one thread each (started here, closed on exit)."""
+    Client, LocalCluster = dask_distributed()
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
+                               dashboard_address=None, env={"TDEM_THREADS": "1"})
+        client = Client(cluster)
+    else:
+        client = Client(scheduler)
+    try:
+        yield client
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

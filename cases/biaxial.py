@@ -301,21 +301,6 @@ def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None):
             for s in confining for (m, d) in materials]
 
 
-SWEEP_INSTALL = 'pip install "tdem[sweep]"'
-
-
-def dask_distributed():
-    """(Client, LocalCluster) of ``distributed``, imported on first use: Dask is an
-    optional extra of tdem. ImportError naming the install command when it is missing."""
-    try:
-        from distributed import Client, LocalCluster
-    except ImportError as e:
-        raise ImportError(f"the sweep runs on Dask (dask.distributed), which is not "
-                          f"installed: {SWEEP_INSTALL} (or pip install "
-                          f'"dask[distributed]") ({e})') from None
-    return Client, LocalCluster
-
-
 def run_sweep(tasks, scheduler=None, workers=2):
     """Run ``tasks`` on Dask and return their results in order.
 
@@ -324,15 +309,7 @@ def run_sweep(tasks, scheduler=None, workers=2):
     the scheduler, so workers need no shared disk. ``scheduler``: address of an
     existing cluster; None starts a ``distributed.LocalCluster`` of ``workers``
     processes with one thread each. Needs Dask (``pip install "tdem[sweep]"``)."""
-    Client, LocalCluster = dask_distributed()
-    cluster = None
-    if scheduler is None:
-        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
-                               dashboard_address=None, env={"TDEM_THREADS": "1"})
-        client = Client(cluster)
-    else:
-        client = Client(scheduler)
-    try:
+    with common.dask_client(scheduler, workers) as client:
         specimens = {}
         for t in tasks:
             key = specimen_key(t)
@@ -341,10 +318,6 @@ def run_sweep(tasks, scheduler=None, workers=2):
         futures = [client.submit(shear_task, t, specimens[specimen_key(t)], pure=False)
                    for t in tasks]
         return client.gather(futures)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def run_serial(tasks):
@@ -663,7 +636,7 @@ def main(argv=None):
         raise InputError(f"confining must be a positive stress in Pa, got {args.confining!r}")
     if args.sweep:
         try:
-            dask_distributed()
+            common.dask_distributed()
         except ImportError as e:
             print(f"biaxial --sweep: {e}", file=sys.stderr)
             return 2

@@ -524,17 +524,8 @@ def run_sweep(tasks, out, workers=2, scheduler=None):
     """Run ``tasks`` on Dask (a ``distributed.LocalCluster`` of ``workers`` processes
     with one thread each, or the cluster at ``scheduler``), printing each run as it
     ends; returns the rows in task order."""
-    from cases.biaxial import dask_distributed
-    Client, LocalCluster = dask_distributed()
-    from distributed import as_completed
-    cluster = None
-    if scheduler is None:
-        cluster = LocalCluster(n_workers=int(workers), threads_per_worker=1, processes=True,
-                               dashboard_address=None, env={"TDEM_THREADS": "1"})
-        client = Client(cluster)
-    else:
-        client = Client(scheduler)
-    try:
+    with common.dask_client(scheduler, workers) as client:
+        from distributed import as_completed
         futures = [client.submit(sweep_task, t, str(out), pure=False) for t in tasks]
         index = {f.key: k for k, f in enumerate(futures)}
         rows = [None] * len(tasks)
@@ -545,10 +536,6 @@ def run_sweep(tasks, out, workers=2, scheduler=None):
                   f"(dx {r['top_dx_max_m']:.3f} m, rotation {r['top_rotation_max_deg']:.1f}°, "
                   f"{r['wall_s'] / 60:.1f} min)", flush=True)
         return rows
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def plot_sweep(rows, png):
@@ -595,8 +582,14 @@ def _extra(p):
 
 def main_sweep(args, out):
     import json
+    from tdem.errors import InputError
     if args.workers < 1:
-        raise SystemExit(f"--workers must be >= 1, got {args.workers}")
+        raise InputError(f"workers must be >= 1, got {args.workers!r}")
+    try:
+        common.dask_distributed()
+    except ImportError as e:
+        print(f"water_blocks --sweep: {e}", file=sys.stderr)
+        return 2
     tasks = sweep_tasks(args.preset, args.arch)
     print(f"water_blocks sweep ({args.preset}): {len(tasks)} runs of four columns on "
           f"{args.scheduler or f'{args.workers} local workers'}", flush=True)

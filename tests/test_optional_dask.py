@@ -20,6 +20,9 @@ def test_tdem_imports_without_dask_and_the_sweep_names_the_extra(tmp_path):
             biaxial.run_sweep([], workers=1)
         except ImportError as e:
             print("ERROR:", e)
+        from cases import water_blocks
+        rc = water_blocks.main(["--sweep", "--out", sys.argv[1]])
+        assert rc == 2, rc
         sys.exit(biaxial.main(["--sweep", "--out", sys.argv[1]]))
     """)
     out = subprocess.run([sys.executable, "-c", code, str(tmp_path)], capture_output=True,
@@ -28,6 +31,7 @@ def test_tdem_imports_without_dask_and_the_sweep_names_the_extra(tmp_path):
     assert 'ERROR: the sweep runs on Dask' in out.stdout
     assert 'pip install "tdem[sweep]"' in out.stdout
     assert 'biaxial --sweep: the sweep runs on Dask' in out.stderr
+    assert 'water_blocks --sweep: the sweep runs on Dask' in out.stderr
     assert 'pip install "tdem[sweep]"' in out.stderr
 
 
