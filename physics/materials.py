@@ -122,8 +122,9 @@ MAT_WIDTH = 17
  MAT_COH_R, MAT_TEN_R, MAT_VISC, MAT_B1, MAT_B2, MAT_SQ_NPHI, MAT_AP,
  MAT_DEPS) = range(MAT_WIDTH)
 MAT_EOS = MAT_COH          # a Fluid row: 1 with the equation of state
-# a JWL row's columns 4-10
+# a JWL row's columns 4-10, and 14: 1 when its particles swell (JWL.swelling)
 JWL_A, JWL_B, JWL_R1, JWL_R2, JWL_OMEGA, JWL_E0, JWL_D = range(4, 11)
+JWL_SWELL = MAT_SQ_NPHI
 ELASTIC, MOHR_COULOMB, FLUID, JWL_TYPE = 0, 1, 2, 3
 NO_FAILURE, SHEAR_FAILURE, TENSION_FAILURE = 0, 1, 2
 
@@ -176,6 +177,8 @@ class Material:
                    "JWL": JWL}
         if kind not in classes:
             raise InputError(f"type must be one of {sorted(classes)}, got {kind!r}")
+        if kind == "JWL":
+            d.setdefault("swelling", False)    # written before the gas could swell
         return classes[kind](**d)
 
     def __repr__(self):
@@ -442,12 +445,28 @@ class JWL(Material):
     fraction F = min(1, (t − t_l)·D/(3R)) for t ≥ t_l (0 before: the front crosses
     one particle diameter and a half), R the particle radius.
 
+    Swelling (``swelling=True``, the default): the radius a particle's element
+    rules see (Eqs. 1–3) grows with the volume its gas fills, s·R0 + δ(s − 1)/2
+    with s = sqrt(max(V, 1)), so that the Eq. 1 cut-off R_i + R_j + δ of two
+    particles that expanded alike grows as their distance does: the products'
+    triangles stay joined as the gas expands and keep pushing on what confines
+    it. Without it a triangle of the gas breaks once an edge exceeds R_i + R_j +
+    δ: on a square lattice with δ = R the diagonals go at V = 1.125 of a uniform
+    expansion, and from then on the gas pushes only through the contact law of
+    its particles, which does not depend on V. The contact radius, the
+    mass and the burn fraction keep R0. The rule radius of each particle is
+    updated at the end of every step from its V (:func:`physics.pcmm.swell`): a
+    particle whose rule radius changed rebuilds its elements, and one whose
+    displacement plus growth since the neighbour lists were built exceeds half
+    the skin asks for a new build, so the Eq. 1 candidates stay complete.
+
     Parameters
     ----------
     A, B : Pa, > 0;  R1, R2 : > 0;  omega : ω > 0;  E0 : initial internal energy per
     unit volume (Pa), > 0;  density : ρ0 (kg/m³), > 0;  D : detonation speed (m/s), > 0
     linear_viscosity, quadratic_viscosity : artificial bulk viscosity b1, b2 ≥ 0
         (module docstring), default 0.06 and 1.5 (the usual hydrocode values)
+    swelling : True (default) or False, above
 
     The time step uses D as the signal speed (the column K = ρ0 D²), and the
     default contact stiffness of its particles (contact law against other bodies)
@@ -455,10 +474,10 @@ class JWL(Material):
     """
 
     _ARGS = ("A", "B", "R1", "R2", "omega", "E0", "density", "D", "linear_viscosity",
-             "quadratic_viscosity")
+             "quadratic_viscosity", "swelling")
 
     def __init__(self, *, A, B, R1, R2, omega, E0, density, D, linear_viscosity=0.06,
-                 quadratic_viscosity=1.5):
+                 quadratic_viscosity=1.5, swelling=True):
         self.A = positive("A", A)
         self.B = positive("B", B)
         self.R1 = positive("R1", R1)
@@ -469,6 +488,9 @@ class JWL(Material):
         self.D = positive("D", D)
         self.linear_viscosity = non_negative("linear_viscosity", linear_viscosity)
         self.quadratic_viscosity = non_negative("quadratic_viscosity", quadratic_viscosity)
+        if swelling not in (True, False):
+            raise InputError(f"swelling must be True or False, got {swelling!r}")
+        self.swelling = bool(swelling)
         self.bulk = self.density * self.D ** 2
         self.shear = 0.0
         self.young = self.bulk
@@ -495,7 +517,8 @@ class JWL(Material):
     def row(self):
         return [float(JWL_TYPE), self.density, self.bulk, 0.0,
                 self.A, self.B, self.R1, self.R2, self.omega, self.E0, self.D, 0.0,
-                self.linear_viscosity, self.quadratic_viscosity, 0.0, 0.0, 0.0]
+                self.linear_viscosity, self.quadratic_viscosity,
+                1.0 if self.swelling else 0.0, 0.0, 0.0]
 
 
 @ti.func

@@ -44,7 +44,7 @@ _SNAP_PARTICLES = ("psig", "peps", "pstate", "pjwl", "xforce", "ccnt", "ecnt", "
                    "esig")
 _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig", "tstate",
                            "nflags", "psedge", "psforce", "psbroken", "vsedge", "vsforce",
-                           "vsbroken", "rstate", "nwork", "rwork")
+                           "vsbroken", "rstate", "nwork", "rwork", "rrule", "rcand", "rmax")
 # what a checkpoint saves: the dynamic state and the nodes' initial positions (the rest
 # is set up again from the host description), and what the element system derives at
 # each step that ``elements()`` reads (element areas and N_e: a loaded model reports
@@ -116,9 +116,18 @@ class Continuum:
         nm = max(len(slots), 1)
         a["rad"] = ti.ndarray(ti.f64, (n,))
         a["pmat"] = ti.ndarray(ti.i32, (n,))
+        # the radii the element rules see (a swelling JWL particle's grow,
+        # physics.pcmm.swell), as they were when the candidates were made, and the
+        # largest grown one (0 while none has grown)
+        a["rrule"] = ti.ndarray(ti.f64, (n,))
+        a["rcand"] = ti.ndarray(ti.f64, (n,))
+        a["rmax"] = ti.ndarray(ti.f64, (1,))
+        a["rmax"].fill(0.0)
         if self.n:
             a["rad"].from_numpy(np.asarray(rad, dtype=np.float64))
             a["pmat"].from_numpy(pmat.astype(np.int32))
+            a["rrule"].from_numpy(np.asarray(rad, dtype=np.float64))
+            a["rcand"].from_numpy(np.asarray(rad, dtype=np.float64))
         a["matp"] = ti.ndarray(ti.f64, (nm, MAT_WIDTH))
         a["mtol"] = ti.ndarray(ti.f64, (nm,))
         self.upload_materials()
@@ -529,7 +538,8 @@ class Continuum:
         if not self.has_pcmm:
             return
         a, e = self.a, sim._a
-        pcmm.candidates(e["pos"], a["rad"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
+        pcmm.candidates(e["pos"], a["rrule"], a["rcand"], a["rmax"], a["pmat"], a["mtol"],
+                        a["cand"], a["ccnt"],
                         e["cell_count"], e["cell_start"], e["sorted"], e["gridp"],
                         e["gridn"], e["flags"], a["pflags"], F_BUILDS,
                         float(sim.skin), int(reach))
@@ -545,6 +555,16 @@ class Continuum:
         (physics.pcmm.volumes), for the next step's update."""
         if self.has_pcmm and self.eos:
             pcmm.volumes(self.a, sim._a, float(dt), sim._serial())
+            if self.swells:
+                a, e = self.a, sim._a
+                pcmm.swell(a["pmat"], a["matp"], a["rad"], a["rrule"], a["rcand"], a["rmax"],
+                           a["mtol"], a["pjwl"], a["cand"], a["ccnt"], a["pbud"], e["pos"], e["xref"],
+                           e["flags"], float(sim.skin), sim._serial())
+
+    @property
+    def swells(self):
+        """Whether a JWL body of this model swells (:class:`physics.materials.JWL`)."""
+        return any(isinstance(m, JWL) and m.swelling for m, _ in self.slots)
 
     def block_stresses(self, sim, dt):
         """Stage: block triangles' stresses and their nodal forces into ``nforce``."""

@@ -102,7 +102,8 @@ re-exported here (``physics.pcmm.NAME``).
   :func:`check_rules`;
 - :mod:`physics.pcmm.rebuild` — the engine-side system: :func:`candidates` and the
   lazy rebuild (:func:`displacements`, :func:`rebuild_elements`, :func:`mark_dirty`,
-  :func:`copies`, :func:`incidence`, :func:`record_slots`, :func:`sync_copies`);
+  :func:`copies`, :func:`incidence`, :func:`record_slots`, :func:`sync_copies`), the
+  swelling JWL particles' rule radii (:func:`swell`);
 - :mod:`physics.pcmm.stress` — the stress pass (:func:`stresses`,
   :func:`equation_of_state`) and the records the gather reads;
 - :mod:`physics.pcmm.nodal` — the gather (:func:`gather`): each particle's force,
@@ -116,7 +117,7 @@ from .system import (F_NEED, F_OVER, FLAGS_SIZE, MAX_CAPACITY, ElementSystem, bi
                      check_rules, count_cover, create_elements, element_masses, find_neighbours)
 from .rebuild import (EPOCH_REBUILT, EPOCH_RECOUNT, REBUILT_CHANGED, REBUILT_SAME, SLACK_FLOOR,
                       candidates, copies, displacements, incidence, mark_dirty, rebuild_elements,
-                      record_slots, sync_copies)
+                      record_slots, swell, sync_copies)
 from .stress import (LOW32, bulk_viscosity, eos_volumes, equation_of_state, stresses,
                      viscous_stress)
 from .nodal import CARRIED, FLUID_CORE, fluid_core_force, gather
@@ -133,7 +134,7 @@ __all__ = [
     "bin_particles", "find_neighbours", "create_elements", "count_cover", "element_masses",
     # the engine-side system
     "candidates", "displacements", "rebuild_elements", "mark_dirty", "copies", "sync_copies",
-    "record_slots", "incidence", "EPOCH_REBUILT", "EPOCH_RECOUNT", "REBUILT_CHANGED",
+    "record_slots", "incidence", "swell", "EPOCH_REBUILT", "EPOCH_RECOUNT", "REBUILT_CHANGED",
     "REBUILT_SAME", "SLACK_FLOOR",
     # stresses
     "stresses", "equation_of_state", "eos_volumes", "bulk_viscosity", "viscous_stress",

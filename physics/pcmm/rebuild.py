@@ -18,7 +18,9 @@ date before the host reads or saves them.
 """
 import taichi as ti
 
+from physics.materials import JWL_SWELL, JWL_TYPE, MAT_TYPE
 from tdem.launch import cached
+from tdem.neighbors import F_REBUILD
 
 from .layout import (MAX_INCIDENT, P_BUILDS, P_BUILT, P_EPOCH, P_INC, P_NEED, P_NEW,
                      P_REBUILT, P_RECOUNT, P_SOFT, SCAN_BLOCK)
@@ -33,20 +35,25 @@ SLACK_FLOOR = 1e-9     # relative to the radius: slack below this counts as none
 
 @cached
 @ti.kernel
-def candidates(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndarray(),
+def candidates(pos: ti.types.ndarray(), rad: ti.types.ndarray(), rcand: ti.types.ndarray(),
+               rmax: ti.types.ndarray(), pmat: ti.types.ndarray(),
                mtol: ti.types.ndarray(), cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
                cell_count: ti.types.ndarray(), cell_start: ti.types.ndarray(),
                sorted_ids: ti.types.ndarray(), gridp: ti.types.ndarray(),
                gridn: ti.types.ndarray(), flags: ti.types.ndarray(),
                pflags: ti.types.ndarray(), builds: ti.i32, skin: ti.f64, reach: ti.i32):
     """Verlet candidates of Eq. 1: every j of the same body with
-    d_ij < R_i + R_j + δ + skin, sorted by index, from the engine's cell grid.
+    d_ij < R_i + R_j + δ + skin, sorted by index, from the engine's cell grid;
+    ``rad`` the radii the rules see (a swelling JWL particle's grows, :func:`swell`),
+    kept in ``rcand`` as they were at this build.
 
     Runs only when the engine has rebuilt its lists since the candidates were made
     (``flags[builds] != pflags[P_BUILDS]``): between builds no particle moves more
-    than half the skin, so every pair within the Eq. 1 distance stays listed.
-    ``reach``: how many cells to search on each side (the Eq. 1 cut-off plus the
-    skin can exceed the engine's cell side).
+    than half the skin, less its rule radius's growth (:func:`swell`), so every
+    pair within the Eq. 1 distance stays listed. ``reach``: how many cells to
+    search on each side (the Eq. 1 cut-off plus the skin can exceed the engine's
+    cell side), widened where the rule radii have grown (``rmax[0]``, the largest
+    grown rule radius, by :func:`swell`).
     """
     n = pos.shape[0]
     cap = cand.shape[1]
@@ -57,11 +64,16 @@ def candidates(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.
             m = pmat[i]
             xi = pos[i]
             ri = rad[i]
+            rcand[i] = ri
+            reach_i = reach
+            if rmax[0] > 0.0:
+                reach_i = ti.max(reach, ti.cast(ti.ceil((ri + rmax[0] + mtol[m] + skin)
+                                                        / gridp[2]), ti.i32))
             cx = ti.math.clamp(ti.cast(ti.floor((xi[0] - gridp[0]) / gridp[2]), ti.i32), 0, nx - 1)
             cy = ti.math.clamp(ti.cast(ti.floor((xi[1] - gridp[1]) / gridp[2]), ti.i32), 0, ny - 1)
             cnt = 0
-            for ccy in range(ti.max(cy - reach, 0), ti.min(cy + reach + 1, ny)):
-                for ccx in range(ti.max(cx - reach, 0), ti.min(cx + reach + 1, nx)):
+            for ccy in range(ti.max(cy - reach_i, 0), ti.min(cy + reach_i + 1, ny)):
+                for ccx in range(ti.max(cx - reach_i, 0), ti.min(cx + reach_i + 1, nx)):
                     c = ccy * nx + ccx
                     for s in range(cell_start[c], cell_start[c] + cell_count[c]):
                         j = sorted_ids[s]
@@ -167,6 +179,46 @@ def _stress_of(i, s, sig: ti.template(), eidx: ti.template(), esig: ti.template(
     else:
         out = esig[o, so]
     return out
+
+
+@cached
+@ti.kernel
+def swell(pmat: ti.types.ndarray(), matp: ti.types.ndarray(), rad: ti.types.ndarray(),
+          rrule: ti.types.ndarray(), rcand: ti.types.ndarray(), rmax: ti.types.ndarray(),
+          mtol: ti.types.ndarray(), pjwl: ti.types.ndarray(), cand: ti.types.ndarray(),
+          ccnt: ti.types.ndarray(),
+          pbud: ti.types.ndarray(), pos: ti.types.ndarray(), xref: ti.types.ndarray(),
+          flags: ti.types.ndarray(), skin: ti.f64, serial: ti.template()):
+    """The end of a step: the rule radius of each swelling JWL particle
+    (:class:`physics.materials.JWL`), s·R0 + δ(s − 1)/2 with s = sqrt(max(V, 1)),
+    V its relative volume (``pjwl`` column 0; ``rad`` the radii R0, ``mtol`` δ):
+    the Eq. 1 cut-off R_i + R_j + δ of two particles that expanded alike by s is
+    then s times the first, so a uniform expansion keeps every Eq. 1 pair. A
+    particle whose rule radius
+    changed, and every candidate of it, rebuild their elements at the next step
+    (``pbud`` = −1: the slacks of the rules knew the old radius). A particle whose
+    displacement since the neighbour lists were built (``xref``) plus its rule
+    radius's growth since the candidates were made (``rcand``) exceeds half the skin
+    asks for a new build (``flags[F_REBUILD]``): a pair left out of the candidates
+    was then at least R_i + R_j + δ + skin apart, and each has since closed at most
+    half the skin on it. ``rmax[0]``: the largest grown rule radius (0 while none
+    has grown), for the candidates' reach."""
+    ti.loop_config(serialize=serial)
+    for i in range(pmat.shape[0]):
+        M = pmat[i]
+        if M >= 0:
+            if ti.cast(matp[M, MAT_TYPE], ti.i32) == JWL_TYPE and matp[M, JWL_SWELL] > 0.0:
+                sc = ti.sqrt(ti.max(pjwl[i][0], 1.0))
+                r = sc * rad[i] + 0.5 * (sc - 1.0) * mtol[M]
+                if r != rrule[i]:
+                    rrule[i] = r
+                    pbud[i] = -1.0
+                    for q in range(ccnt[i]):
+                        pbud[cand[i, q]] = -1.0
+                if r > rad[i]:
+                    ti.atomic_max(rmax[0], r)
+                if (pos[i] - xref[i]).norm() + (r - rcand[i]) > 0.5 * skin:
+                    flags[F_REBUILD] = 1
 
 
 @cached
