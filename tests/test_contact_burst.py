@@ -31,7 +31,9 @@ def test_p1_starts_moving_with_the_p_wave(first_ms):
     """P1 (x = 4.8 m) starts to move (|u_x| > 1 % of its maximum in the first
     millisecond) when the P-wave from the charge's contact point arrives, within
     10 %: 0.26 ms. The paper's 0.46 ms is nearer the Rayleigh wave's 0.49 ms (its
-    threshold of "starts to move" is not given)."""
+    threshold of "starts to move" is not given). Measured 0.233 ms, 9.9 % early:
+    the swelling products spread along the surface and load it nearer P1 than the
+    contact point (0.225 ms with the rock's R = 0.04 m)."""
     start = common.checks_by_name(first_ms)["P1_start"]["value"]
     assert start == pytest.approx(first_ms["data"]["P1_arrivals_s"]["p_wave"], rel=0.10)
 
@@ -47,11 +49,13 @@ def test_crater_reported_not_compared_before_3_6_ms(first_ms):
 
 
 def test_charge_products_expand_and_convert_energy(first_ms):
-    """The detonation products push the rock: some of their energy became motion
-    (the rest stays in particles whose elements broke, see the case docstring)."""
+    """The swelling products (``tdem.JWL``) keep their elements as they expand and
+    give up most of their energy in the first millisecond (measured 65 %, at
+    relative volumes up to 108; without swelling their elements broke at V ≈ 1.4–2.5
+    and 75 % of the energy was still inside at 3.6 ms)."""
     ch = first_ms["data"]["charge"]
-    assert ch["max_relative_volume"] > 1.2
-    assert 0.0 < 1.0 - ch["energy_left_fraction"] < 0.5
+    assert ch["max_relative_volume"] > 10.0
+    assert 0.5 < 1.0 - ch["energy_left_fraction"] < 1.0
 
 
 def _energy_bound(s):
