@@ -317,7 +317,16 @@ def run_sweep(tasks, scheduler=None, workers=2):
                 specimens[key] = client.submit(prepare_task, t, pure=False)
         futures = [client.submit(shear_task, t, specimens[specimen_key(t)], pure=False)
                    for t in tasks]
-        return client.gather(futures)
+        from distributed import as_completed
+        index = {f.key: k for k, f in enumerate(futures)}
+        results = [None] * len(tasks)
+        for done, f in enumerate(as_completed(futures), 1):
+            r = f.result()
+            results[index[f.key]] = r
+            print(f"biaxial sweep: {done}/{len(tasks)} {r['name']} at "
+                  f"{r['task']['confining'] / 1e3:g} kPa: peak phi {r['phi']['phi_peak']:.1f}°, "
+                  f"residual {r['phi']['phi_residual']:.1f}° ({r['wall_s']:.0f} s)", flush=True)
+        return results
 
 
 def run_serial(tasks):
@@ -565,14 +574,21 @@ def _extra(p):
                    help="with --sweep: address of an existing Dask scheduler")
     p.add_argument("--workers", type=int, default=2,
                    help="with --sweep: worker processes of the local cluster (default 2)")
+    p.add_argument("--all-deltas", action="store_true",
+                   help="with --sweep: the paper's 33 materials (delta = 0, 0.1 ... 1.6, "
+                        "Models 1 and 2) at this preset's strain rate and strain")
 
 
 def _main_sweep(args, out, cfg, clock):
     from tdem.errors import InputError
     if args.workers < 1:
         raise InputError(f"workers must be >= 1, got {args.workers!r}")
-    tasks = sweep_tasks(cfg["sweep"], arch=args.arch)
-    print(f"biaxial sweep ({args.preset}): {len(tasks)} tasks on "
+    sweep = dict(cfg["sweep"])
+    if args.all_deltas:
+        sweep["materials"] = PRESETS["paper"]["sweep"]["materials"]
+    tasks = sweep_tasks(sweep, arch=args.arch)
+    print(f"biaxial sweep ({args.preset}"
+          f"{', all deltas' if args.all_deltas else ''}): {len(tasks)} tasks on "
           f"{args.scheduler or f'a local cluster of {args.workers} workers'}", flush=True)
     results = run_sweep(tasks, scheduler=args.scheduler, workers=args.workers)
     env = envelopes(results)
@@ -634,6 +650,8 @@ def main(argv=None):
     cfg = PRESETS[args.preset]
     if not (args.confining > 0 and math.isfinite(args.confining)):
         raise InputError(f"confining must be a positive stress in Pa, got {args.confining!r}")
+    if args.all_deltas and not args.sweep:
+        raise InputError("all_deltas: only with --sweep")
     if args.sweep:
         try:
             common.dask_distributed()

@@ -44,13 +44,15 @@ _SNAP_PARTICLES = ("psig", "peps", "pstate", "pjwl", "xforce", "ccnt", "ecnt", "
                    "esig")
 _SNAP = _SNAP_PARTICLES + ("pflags", "npos", "nvel", "nforce", "nreact", "tsig", "tstate",
                            "nflags", "psedge", "psforce", "psbroken", "vsedge", "vsforce",
-                           "vsbroken", "rstate", "nwork", "rwork", "rrule", "rcand", "rmax")
-# what a checkpoint saves: the dynamic state and the nodes' initial positions (the rest
-# is set up again from the host description), and what the element system derives at
-# each step that ``elements()`` reads (element areas and N_e: a loaded model reports
-# them before its first step; files without them still load)
+                           "vsbroken", "rstate", "nwork", "rwork", "rrule", "rcand", "rmax",
+                           "earea", "ncov")
+# (the last two: what the element system derives at each step that ``elements()``
+# reads, element areas and N_e, so that a restored or loaded model reports them before
+# its next step; files without them still load)
 SAVED_DERIVED = ("earea", "ncov")
-SAVED = _SNAP + ("npos0", "nload") + SAVED_DERIVED
+# what a checkpoint saves: the dynamic state and the nodes' initial positions (the rest
+# is set up again from the host description)
+SAVED = _SNAP + ("npos0", "nload")
 
 
 @cached
