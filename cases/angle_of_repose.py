@@ -563,7 +563,7 @@ def base_cell(half_base, width, count):
 
 
 # ------------------------------------------------------------------ runs
-def run_heap(model, sequence, cfg, opts, seed, angle=None, log=print):
+def run_heap(model, sequence, cfg, opts, seed, angle=None, log=common.say):
     w0 = time.perf_counter()
     heap = Heap(model, cfg, opts, seed)
     if sequence == "wedge":

@@ -319,7 +319,7 @@ def settle(sim, max_time, calm, damping, fraction, chunk=0.1, hold=3, log=None):
     return sim.time - t0, ratio
 
 
-def build_bed(cfg, opts, log=print):
+def build_bed(cfg, opts, log=common.say):
     """The settled, cut and re-settled bed: (sim, floor, law, info)."""
     hm = law()
     n, box = cfg["particles"], cfg["box"]
@@ -361,7 +361,10 @@ def bed_top(sim):
     return float((p["position"][:, 2] + half_height(p["orientation"])).max())
 
 
-def compress(sim, floor, hm, cfg, out=None, log=print):
+PROGRESS_S = 60.0   # s of wall time between the compression's progress lines
+
+
+def compress(sim, floor, hm, cfg, out=None, log=common.say):
     """The plate from the top of the bed down at the preset's speed until the last
     snapshot stress: (history rows, snapshots, plate, extra)."""
     box = cfg["box"]
@@ -385,6 +388,8 @@ def compress(sim, floor, hm, cfg, out=None, log=print):
     level = 0
     t_start = sim.time
     max_travel = 1.0
+    shown = time.perf_counter()         # a progress line a minute between snapshots
+    steps0 = sim.steps
     while level < len(SNAPSHOT_STRESSES):
         w0 = time.perf_counter()
         sim.run(steps=poll if not rows or rows[-1][2] < FINE_STRESS else fine)
@@ -408,6 +413,11 @@ def compress(sim, floor, hm, cfg, out=None, log=print):
                 level += 1
             log(f"  snapshot {len(snaps)} at {stress / 1e3:.0f} kPa, plate travel "
                 f"{1e3 * travel:.1f} mm")
+        elif time.perf_counter() - shown > PROGRESS_S:
+            log(f"  plate travel {1e3 * travel:.1f} mm, {stress / 1e3:.1f} kPa, "
+                f"{sim.steps - steps0} steps at {(sim.steps - steps0) / max(run_wall, 1e-9):.0f}"
+                f" steps/s")
+            shown = time.perf_counter()
         if travel > max_travel:
             raise RuntimeError(f"the plate went {max_travel} m down without reaching "
                                f"{SNAPSHOT_STRESSES[-1] / 1e3:.0f} kPa")
