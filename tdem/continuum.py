@@ -799,6 +799,34 @@ class Continuum:
                 total += _stored(el["stress"], el["stress_zz"], row, area)
         return total
 
+    def core_energy(self, pos):
+        """Potential energy (J/m) of the core force between same-body Fluid or JWL
+        neighbours (:func:`physics.pcmm.fluid_core_force`): Σ ½ K (λ(R_i + R_j) −
+        d)² over the Eq. 1 pairs closer than λ(R_i + R_j), each pair once; ``pos``
+        the particles' positions. It is zero unless two such particles overlap by a
+        quarter of their radii (a detonation's products thrown back from a wall)."""
+        if not self.has_pcmm:
+            return 0.0
+        slots = [s for s, (m, _) in enumerate(self.slots) if isinstance(m, (Fluid, JWL))]
+        if not slots:
+            return 0.0
+        pmat = self.a["pmat"].to_numpy()[:self.n]
+        ncnt = self.a["ncnt"].to_numpy()[:self.n]
+        nbr = self.a["nbr"].to_numpy()[:self.n]
+        rad = self.a["rad"].to_numpy()[:self.n]
+        ii = np.flatnonzero(np.isin(pmat, slots) & (ncnt > 0))
+        if not len(ii):
+            return 0.0
+        cols = np.arange(nbr.shape[1])
+        keep = cols[None, :] < ncnt[ii, None]
+        i = np.broadcast_to(ii[:, None], keep.shape)[keep]
+        j = nbr[ii][keep]
+        i, j = i[j > i], j[j > i]
+        dc = pcmm.FLUID_CORE * (rad[i] + rad[j])
+        gap = np.maximum(dc - np.linalg.norm(pos[j] - pos[i], axis=1), 0.0)
+        k = np.array([m.bulk if isinstance(m, (Fluid, JWL)) else 0.0 for m, _ in self.slots])
+        return float(np.sum(0.5 * k[pmat[i]] * gap * gap))
+
     def restart_work(self):
         """The work account of the nodes and rigid blocks starts now (zero work, the
         kinetic energy now as the start's)."""

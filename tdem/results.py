@@ -253,7 +253,9 @@ class Results:
     def energy(self):
         """Energy account (J per metre of thickness) at the last completed step:
         kinetic, gravitational (relative to the origin), elastic (contact springs),
-        strain (PCMM elements and blocks, :meth:`tdem.continuum.Continuum.strain_energy`),
+        strain (PCMM elements and blocks, :meth:`tdem.continuum.Continuum.strain_energy`,
+        and the core force between water or explosive particles,
+        :meth:`tdem.continuum.Continuum.core_energy`),
         dissipated (damping, friction, rolling), boundary_work (done by walls and
         prescribed velocities) and total = kinetic + gravitational + elastic + strain +
         dissipated − boundary_work, which is conserved for DEM models; explosive: the
@@ -347,6 +349,10 @@ class Results:
         if self._cont is not None:
             if strain:
                 e["strain"] = self._cont.strain_energy()
+                if self._n:
+                    # at x_n, where the kinetic energy and the contact springs are taken
+                    e["strain"] += self._cont.core_energy(a["pos"].to_numpy()
+                                                          - dt * a["vel"].to_numpy())
             nw, ke, ke0 = self._cont.work_sums()
             e["W_continuum"] += float(nw[0])
             e["W_gravity"] += float(nw[1])
