@@ -579,6 +579,29 @@ def _extra(p):
                         "Models 1 and 2) at this preset's strain rate and strain")
 
 
+def phi_table(tests):
+    """Markdown table of φ against δ from a sweep's tests (dicts with ``task`` and
+    ``phi``): per δ and model, the peak and residual φ as the mean and range over the
+    confining stresses, the paper's value beside where its text gives one."""
+    rows = ["| δ | Model 1 peak φ | Model 1 residual φ | Model 2 peak φ | "
+            "Model 2 residual φ |", "| --- | --- | --- | --- | --- |"]
+
+    def cell(model, delta, key, col):
+        vals = [t["phi"][key] for t in tests if t["task"]["delta"] == delta
+                and (t["task"]["model"] == model or delta == 0.0)]
+        if not vals:
+            return "–"
+        paper = TARGETS.get((0 if delta == 0.0 else model, delta))
+        text = f"{np.mean(vals):.1f}° ({min(vals):.1f}–{max(vals):.1f})"
+        return text + (f", paper {paper[col]:.1f}°" if paper else "")
+
+    for d in sorted({t["task"]["delta"] for t in tests}):
+        rows.append(f"| {d:g} | " + " | ".join(
+            cell(m, d, k, c) for m in (1, 2)
+            for k, c in (("phi_peak", 0), ("phi_residual", 1))) + " |")
+    return "\n".join(rows) + "\n"
+
+
 def _main_sweep(args, out, cfg, clock):
     from tdem.errors import InputError
     if args.workers < 1:
@@ -595,6 +618,10 @@ def _main_sweep(args, out, cfg, clock):
     save_results(out / "sweep.h5", results, extra={"envelopes": env})
     plot_fig12(env, out / "fig12_envelopes.png")
     plot_fig13(results, out / "fig13_phi_delta.png")
+    (out / "sweep.md").write_text(
+        f"φ against δ, {len(results)} tests ({args.preset} preset's rate and strain; "
+        "mean and range over the confining stresses):\n\n" + phi_table(
+            [{"task": r["task"], "phi": r["phi"]} for r in results]))
     checks = []
     for (model, delta), (pk, rs) in TARGETS.items():
         name = material_name(model, delta)

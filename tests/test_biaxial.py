@@ -97,6 +97,8 @@ def test_bad_input_names_the_argument(small, tmp_path):
         biaxial.check_material(1, -0.4)
     with pytest.raises(ValueError, match="confining"):
         biaxial.main(["--confining", "-5", "--out", str(tmp_path)])
+    with pytest.raises(ValueError, match="all_deltas"):
+        biaxial.main(["--all-deltas", "--out", str(tmp_path)])
 
 
 def test_friction_angle_formula():
@@ -107,6 +109,26 @@ def test_friction_angle_formula():
     phi = specimen.friction_angles(r, smoothing=0.0)
     assert phi["phi_peak"] == pytest.approx(math.degrees(math.asin(4.0 / 6.0)))
     assert phi["phi_residual"] == pytest.approx(30.0)       # sin phi = 2/4
+
+
+def test_phi_table_means_ranges_and_the_papers_values():
+    """The sweep's sweep.md: per δ and model the mean and range of φ over the
+    confining stresses; δ = 0 (no rolling resistance) in both models' columns, the
+    paper's text values beside (24.4/19.3° at δ = 0, 26.5/20.7° for Model 2 at 0.4)."""
+    def t(model, delta, s, pk, rs):
+        return {"task": {"model": model, "delta": delta, "confining": s},
+                "phi": {"phi_peak": pk, "phi_residual": rs}}
+    tests = [t(1, 0.0, 1e5, 24.0, 20.0), t(1, 0.0, 2e5, 26.0, 22.0),
+             t(1, 0.4, 1e5, 30.0, 25.0), t(1, 0.4, 2e5, 31.0, 27.0),
+             t(2, 0.4, 1e5, 25.0, 21.0)]
+    lines = biaxial.phi_table(tests).splitlines()
+    assert len(lines) == 4
+    assert lines[2] == ("| 0 | 25.0° (24.0–26.0), paper 24.4° | 21.0° (20.0–22.0), paper "
+                        "19.3° | 25.0° (24.0–26.0), paper 24.4° | 21.0° (20.0–22.0), "
+                        "paper 19.3° |")
+    assert lines[3] == ("| 0.4 | 30.5° (30.0–31.0), paper 29.0° | 26.0° (25.0–27.0), "
+                        "paper 23.0° | 25.0° (25.0–25.0), paper 26.5° | 21.0° "
+                        "(21.0–21.0), paper 20.7° |")
 
 
 # ------------------------------------------------------------------ the sweep
