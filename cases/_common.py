@@ -661,12 +661,12 @@ def dask_distributed():
     return Client, LocalCluster
 
 
-@contextlib.contextmanager
 def say(text):
     """A progress line, shown at once also when the output goes to a file."""
     print(text, flush=True)
 
 
+@contextlib.contextmanager
 def dask_client(scheduler=None, workers=2):
     """A Dask client of the cluster at ``scheduler``, or of a ``distributed.LocalCluster``
     of ``workers`` processes with one thread each (started here, closed on exit)."""
