@@ -194,8 +194,8 @@ def swell(pmat: ti.types.ndarray(), matp: ti.types.ndarray(), rad: ti.types.ndar
     V its relative volume (``pjwl`` column 0; ``rad`` the radii R0, ``mtol`` δ):
     the Eq. 1 cut-off R_i + R_j + δ of two particles that expanded alike by s is
     then s times the first, so a uniform expansion keeps every Eq. 1 pair. A
-    particle whose rule radius
-    changed, and every candidate of it, rebuild their elements at the next step
+    particle whose rule radius changed, and every candidate of it, rebuild their
+    elements at the next step
     (``pbud`` = −1: the slacks of the rules knew the old radius). A particle whose
     displacement since the neighbour lists were built (``xref``) plus its rule
     radius's growth since the candidates were made (``rcand``) exceeds half the skin
