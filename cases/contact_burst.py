@@ -276,6 +276,7 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
     ratio = {"P5/P4": peaks["P5"] / peaks["P4"] if peaks["P4"] > 0 else None,
              "P6/P4": peaks["P6"] / peaks["P4"] if peaks["P4"] > 0 else None}
     st = sim._cont.jwl_state()[m["charge"].ids]
+    isolated = sim._cont.a["picnt"].to_numpy()[m["charge"].ids] == 0
     R = m["R"]
     at_end = common.reached(sim.time, DURATION)
     checks = []
@@ -321,7 +322,12 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
         "charge_initial_volume_m2": float(st[:, 4].sum()),
         "charge": {"max_relative_volume": float(st[:, 0].max()),
                    "energy_left_fraction": float((st[:, 1] * st[:, 4]).sum()
-                                                 / (7.0e9 * st[:, 4].sum()))},
+                                                 / (7.0e9 * st[:, 4].sum())),
+                   # the part of it in particles no element contains any more (their
+                   # V and E stay as they were when they lost their last element)
+                   "energy_left_fraction_isolated": float(
+                       (st[:, 1] * st[:, 4])[isolated].sum() / (7.0e9 * st[:, 4].sum())),
+                   "isolated_particles": int(isolated.sum())},
         "energy_J_per_m": sim.energy(),
         "monitor_particles": mon,
     }
