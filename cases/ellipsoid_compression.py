@@ -67,10 +67,11 @@ loading plate's forces spread wider than the q-model's, unlike the paper's, but 
 long initial settlement (the plate first meets the tips of the highest particles and
 pushes them down through a rough top, the stress rising and falling as particles
 topple), then a steep, almost linear rise above 400 kPa. The paper preset runs as it
-is; its wall time, estimated from the quick preset's cost per particle of a step and
-of a poll (``paper_preset_estimated_wall_s`` in the quick summary), is about 1.5
-hours on one core, most of it the 1.4–2 million steps of the compression at
-0.02 m/s and Δt = 6.86e-6 s.
+is: 114 minutes on one core (measured 2026-12-05), most of it the 2.67 million steps
+of the compression at 0.02 m/s and Δt = 6.86e-6 s (367 mm of plate travel to 600
+kPa). The estimate from the quick preset's cost per particle of a step and of a poll
+(``paper_preset_estimated_wall_s`` in the quick summary) scales the quick bed's
+travel and said about 1.5 hours.
 
 Decisions the paper leaves open
 -------------------------------
