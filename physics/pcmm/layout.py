@@ -2,6 +2,8 @@
 their state (allocated with these sizes by :class:`tdem.continuum.Continuum`).
 
 Module-level constants read inside kernels are compile-time constants."""
+import taichi as ti
+
 MAX_ELEMENTS = 12        # elements a particle can create (pruned gaps are >= 30 deg)
 MAX_INCIDENT = 64        # slots of a particle's list of the elements containing it
 SCAN_BLOCK = 1024        # particles per block of the prefix sum of record_slots
@@ -18,3 +20,18 @@ P_BUILT = 7      # 1: the candidates were rebuilt this step (the engine rebuilt 
 P_SOFT = 8       # 1: this step renews the epoch (displacements)
 PFLAGS_SIZE = 9
 PFLAGS_INIT = (0, -1, 0, 0, 1, 0, 0, 0, 0)
+
+
+# a particle's list of the elements containing it (``inc``) holds one code each:
+# owner << 6 | slot << 2 | which corner of the element the particle is
+@ti.func
+def inc_code(owner, slot, corner):
+    """The code of the element in ``owner``'s ``slot`` of which the particle is
+    corner ``corner`` (0–2)."""
+    return (owner << 6) | (slot << 2) | corner
+
+
+@ti.func
+def inc_element(code):
+    """The owner and the slot of the element a code of ``inc`` names."""
+    return code >> 6, (code >> 2) & 15

@@ -14,7 +14,7 @@ from tdem.state import PROP_RADIUS
 
 from ..contact_law import PAIR_TAIL, zero_history
 from ..materials import FLUID, JWL_TYPE, MAT_K, MAT_TYPE
-from .layout import P_BUILT, P_NEW
+from .layout import P_BUILT, P_NEW, inc_element
 from .stress import _corner_force, _has_eos, _unpack2
 
 FLUID_CORE = 0.75  # λ of fluid_core_force
@@ -63,8 +63,7 @@ def gather(pos: ti.types.ndarray(), rad: ti.types.ndarray(), pmat: ti.types.ndar
             cnt = ti.cast(iwt[i], ti.f64)
             for q in range(icnt[i]):
                 code = inc[i, q]
-                o = code >> 6
-                s = (code >> 2) & 15
+                o, s = inc_element(code)
                 j = eidx[o, s]
                 r = efor[j]
                 f += _corner_force(code & 3, o, j, r, pos, efor)
@@ -153,8 +152,7 @@ def _shares_element(i, j, inc: ti.template(), icnt: ti.template(), elem: ti.temp
     found = False
     for q in range(icnt[i]):
         code = inc[i, q]
-        o = code >> 6
-        s = (code >> 2) & 15
+        o, s = inc_element(code)
         if o == j or elem[o, s, 0] == j or elem[o, s, 1] == j:
             found = True
     return found

@@ -23,7 +23,7 @@ from tdem.launch import cached
 from tdem.neighbors import F_REBUILD
 
 from .layout import (MAX_INCIDENT, P_BUILDS, P_BUILT, P_EPOCH, P_INC, P_NEED, P_NEW,
-                     P_REBUILT, P_RECOUNT, P_SOFT, SCAN_BLOCK)
+                     P_REBUILT, P_RECOUNT, P_SOFT, SCAN_BLOCK, inc_code)
 from .rules import _create, _dist_slack, _ring
 
 EPOCH_REBUILT = 0.01   # the epoch is renewed after a step that rebuilt this fraction
@@ -497,8 +497,8 @@ def incidence(pmat: ti.types.ndarray(), nbr: ti.types.ndarray(), ncnt: ti.types.
                     for s in range(ecnt[o]):
                         if emult[o, s] > 0 and _corner(o, elem[o, s, 0], elem[o, s, 1], i) >= 0:
                             if cnt < MAX_INCIDENT:
-                                inc[i, cnt] = (o << 6) | (s << 2) | _corner(
-                                    o, elem[o, s, 0], elem[o, s, 1], i)
+                                inc[i, cnt] = inc_code(o, s, _corner(
+                                    o, elem[o, s, 0], elem[o, s, 1], i))
                                 wt += emult[o, s]
                             cnt += 1
                 if cnt > MAX_INCIDENT:

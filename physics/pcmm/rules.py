@@ -15,7 +15,7 @@ import math
 
 import taichi as ti
 
-from .layout import MAX_ELEMENTS
+from .layout import MAX_ELEMENTS, inc_element
 
 MIN_GAP = math.pi / 6.0  # angular pruning threshold (30 deg)
 COS_30 = math.sqrt(3.0) / 2.0
@@ -290,8 +290,7 @@ def _cover_incident(v0, v1, v2, pos: ti.template(), elem: ti.template(),
         v = verts[t]
         for q in range(icnt[v]):
             code = inc[v, q]
-            o = code >> 6
-            s2 = (code >> 2) & 15
+            o, s2 = inc_element(code)
             e1 = elem[o, s2, 0]
             e2 = elem[o, s2, 1]
             take = True

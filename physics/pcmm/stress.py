@@ -17,7 +17,7 @@ from .. import fvm
 from ..materials import (FLUID, JWL_D, JWL_OMEGA, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS, MAT_G,
                          MAT_K, MAT_RHO, MAT_TYPE, MAT_VISC, fluid_pressure, jwl_pressure,
                          mc_correct_state)
-from .layout import P_NEW, P_RECOUNT, P_SOFT
+from .layout import P_NEW, P_RECOUNT, P_SOFT, inc_element
 from .rebuild import SLACK_FLOOR
 from .rules import _cover_incident, _sorted3
 
@@ -286,8 +286,7 @@ def equation_of_state(pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
                 qsum = 0.0
                 for k in range(icnt[i]):
                     code = inc[i, k]
-                    o = code >> 6
-                    sl = (code >> 2) & 15
+                    o, sl = inc_element(code)
                     d = ede[o, sl]
                     mw = ti.cast(emult[o, sl], ti.f64)
                     thsum += mw * d[5] * (d[0] + d[1])
@@ -349,8 +348,7 @@ def eos_volumes(pmat: ti.types.ndarray(), matp: ti.types.ndarray(), pos: ti.type
                 acc = 0.0
                 for k in range(icnt[i]):
                     code = inc[i, k]
-                    o = code >> 6
-                    sl = (code >> 2) & 15
+                    o, sl = inc_element(code)
                     b = elem[o, sl, 0]
                     c = elem[o, sl, 1]
                     xa, xb, xc = pos[o], pos[b], pos[c]
