@@ -666,6 +666,19 @@ def say(text):
     print(text, flush=True)
 
 
+def gather_in_order(futures, name, line):
+    """The results of Dask ``futures`` in their order, printing "``name``: count
+    ``line(result)``" as each one ends (a sweep's progress)."""
+    from distributed import as_completed
+    index = {f.key: k for k, f in enumerate(futures)}
+    results = [None] * len(futures)
+    for done, f in enumerate(as_completed(futures), 1):
+        r = f.result()
+        results[index[f.key]] = r
+        say(f"{name}: {done}/{len(futures)} {line(r)}")
+    return results
+
+
 @contextlib.contextmanager
 def dask_client(scheduler=None, workers=2):
     """A Dask client of the cluster at ``scheduler``, or of a ``distributed.LocalCluster``

@@ -317,16 +317,10 @@ def run_sweep(tasks, scheduler=None, workers=2):
                 specimens[key] = client.submit(prepare_task, t, pure=False)
         futures = [client.submit(shear_task, t, specimens[specimen_key(t)], pure=False)
                    for t in tasks]
-        from distributed import as_completed
-        index = {f.key: k for k, f in enumerate(futures)}
-        results = [None] * len(tasks)
-        for done, f in enumerate(as_completed(futures), 1):
-            r = f.result()
-            results[index[f.key]] = r
-            print(f"biaxial sweep: {done}/{len(tasks)} {r['name']} at "
-                  f"{r['task']['confining'] / 1e3:g} kPa: peak phi {r['phi']['phi_peak']:.1f}°, "
-                  f"residual {r['phi']['phi_residual']:.1f}° ({r['wall_s']:.0f} s)", flush=True)
-        return results
+        return common.gather_in_order(futures, "biaxial sweep", lambda r: (
+            f"{r['name']} at {r['task']['confining'] / 1e3:g} kPa: peak phi "
+            f"{r['phi']['phi_peak']:.1f}°, residual {r['phi']['phi_residual']:.1f}° "
+            f"({r['wall_s']:.0f} s)"))
 
 
 def run_serial(tasks):

@@ -525,17 +525,10 @@ def run_sweep(tasks, out, workers=2, scheduler=None):
     with one thread each, or the cluster at ``scheduler``), printing each run as it
     ends; returns the rows in task order."""
     with common.dask_client(scheduler, workers) as client:
-        from distributed import as_completed
         futures = [client.submit(sweep_task, t, str(out), pure=False) for t in tasks]
-        index = {f.key: k for k, f in enumerate(futures)}
-        rows = [None] * len(tasks)
-        for done, f in enumerate(as_completed(futures), 1):
-            r = f.result()
-            rows[index[f.key]] = r
-            print(f"water_blocks sweep: {done}/{len(tasks)} {task_name(r)}: {r['outcome']} "
-                  f"(dx {r['top_dx_max_m']:.3f} m, rotation {r['top_rotation_max_deg']:.1f}°, "
-                  f"{r['wall_s'] / 60:.1f} min)", flush=True)
-        return rows
+        return common.gather_in_order(futures, "water_blocks sweep", lambda r: (
+            f"{task_name(r)}: {r['outcome']} (dx {r['top_dx_max_m']:.3f} "
+            f"m, rotation {r['top_rotation_max_deg']:.1f}°, {r['wall_s'] / 60:.1f} min)"))
 
 
 def plot_sweep(rows, png):
