@@ -19,6 +19,7 @@ Prints ``PEER tdem <threads> particle_steps_per_s <value>`` like the peers' scri
     python benchmarks/pack3d.py --cubes --yade         # ... and Yade's Polyhedra on them
     python benchmarks/pack3d.py --broad-phase sweep    # sort-and-sweep instead of the grid
     python benchmarks/pack3d.py --cubes --pour         # cubes falling: the lists rebuilt often
+    python benchmarks/pack3d.py --bare                 # ... and the step written bare
 
 Every run prints how many list builds its timed steps made and their time.
 
@@ -284,6 +285,9 @@ def main(argv=None):
     p.add_argument("--broad-phase", default="grid", choices=("grid", "sweep"),
                    help="the neighbour search (tdem.Simulation(broad_phase=)); the time "
                         "its list builds take is printed")
+    p.add_argument("--bare", action="store_true",
+                   help="then the same step written bare (benchmarks/bare3d.py) on the "
+                        "engine's bed, with ndarrays and with fields")
     p.add_argument("--json", default=None, help="append the results to this JSON file")
     args = p.parse_args(argv)
     if args.scaling:
@@ -315,6 +319,16 @@ def main(argv=None):
               f"{100 * clock.seconds / el:.1f} % of the time")
     tag = "-ellipsoids" if args.ellipsoids else "-cubes" if args.cubes else ""
     print(f"PEER tdem{tag} {args.threads} particle_steps_per_s {rate:.0f}", flush=True)
+    if args.bare and not (args.cubes or args.ellipsoids):
+        import bare3d
+        contacts = sim.contacts.numpy()
+        for storage in ("ndarray", "field"):
+            r = bare3d.measure(s, args.steps, contacts, storage=storage)
+            print(f"bare step ({storage}): {r['pairs']} pairs, {r['touching_start']} touching "
+                  f"at the start, {r['touching_end']} at the end, {r['builds']} list builds "
+                  f"(not timed); rate / tdem {r['rate'] / rate:.2f}", flush=True)
+            print(f"PEER bare-{storage} {args.threads} particle_steps_per_s {r['rate']:.0f}",
+                  flush=True)
     if args.cubes and args.yade and bed != "pour":
         print(run_yade(args.steps, args.warmup, args.scale, bed), flush=True)
     if args.json:

@@ -743,6 +743,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     #    then rotation about their centre and translation; a wall that has moved half
     #    the skin since the lists were built asks for a rebuild
     if ti.static(dim == 3):
+        # (on one thread in the same serial task: a parallel loop over a few walls
+        # costs more to launch than to run)
+        ti.loop_config(serialize=serial)
         for w in range(nw):
             move_triangle(wall, w, dt, simp[P_SKIN], flags)
     if ti.static(dim == 2):
