@@ -14,9 +14,9 @@ import taichi as ti
 from tdem.launch import cached
 
 from .. import fvm
-from ..materials import (FLUID, JWL_D, JWL_OMEGA, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS, MAT_G,
-                         MAT_K, MAT_RHO, MAT_TYPE, MAT_VISC, fluid_pressure, jwl_pressure,
-                         mc_correct_state)
+from ..materials import (FLUID, JWL_D, JWL_OMEGA, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS,
+                         MAT_FLUID_TAU, MAT_G, MAT_K, MAT_RHO, MAT_TYPE, MAT_VISC,
+                         fluid_pressure, jwl_pressure, mc_correct_state, relax_shear)
 from .layout import P_NEW, P_RECOUNT, P_SOFT, inc_element
 from .rebuild import SLACK_FLOOR
 from .rules import _cover_incident, _sorted3
@@ -206,6 +206,8 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                         sig = (psig[a] + psig[b] + psig[c]) / 3.0
                     sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
                         de, matp[M, MAT_K], matp[M, MAT_G])
+                    if kind == FLUID:
+                        sig = relax_shear(sig, matp[M, MAT_FLUID_TAU], dt)
                     failed = 0
                     if pfail[a] + pfail[b] + pfail[c] > 0:
                         failed = 1
