@@ -270,7 +270,9 @@ def test_maxwell_water_holds_still_on_a_hexagonal_lattice():
     largest speed 2.7e-3 m/s, limit 0.022), keeps its elements and its area (measured
     within 4e-5), and its pressure grows with depth at ρg within 2 % (measured
     0.993 ρg; single particles scatter about it, see the Fluid docstring); the plain
-    Fluid rearranges (measured: 0.26 m/s, 10 % more elements)."""
+    Fluid rearranges (measured: 0.26 m/s, 10 % more elements). (This G_s·τ is a
+    viscosity of 2000 Pa·s, a syrup's, under which a dam break hardly flows: the
+    Fluid docstring.)"""
     still = hex_column(shear_modulus=0.01, relaxation_time=0.1)
     assert still["vmax"] < still["limit"]
     assert still["n"][1] == still["n"][0]
