@@ -224,6 +224,21 @@ def _run_once(cmd, timeout, capture):
     return subprocess.run(cmd, stdout=out, stderr=subprocess.PIPE, text=True, timeout=timeout)
 
 
+def display_problem():
+    """Why pvpython cannot draw here (a sentence), or None: with no display it needs
+    Xvfb (``Xvfb`` or ``xvfb-run``); Debian's pvpython, run headless without one,
+    crashes (SIGSEGV) rather than saying so."""
+    if _headless() and not (shutil.which("Xvfb") or shutil.which("xvfb-run")):
+        return ("there is no display (DISPLAY is not set) and no Xvfb to make one: "
+                "install it (apt-get install xvfb) or run where a display is")
+    return None
+
+
+def can_render():
+    """Whether pvpython is installed and has a display (real or virtual) to draw on."""
+    return pvpython() is not None and display_problem() is None
+
+
 def run_view(directory, args=(), timeout=600, capture=True, attempts=3):
     """Run ``directory/view.py`` in pvpython with the script's options ``args``: with
     no display, on a virtual one (Xvfb, else ``xvfb-run -a``), tried again up to
@@ -233,6 +248,9 @@ def run_view(directory, args=(), timeout=600, capture=True, attempts=3):
     if cmd is None:
         raise RuntimeError("pvpython is not on PATH: install ParaView (e.g. apt-get "
                            "install paraview xvfb) to render the pictures")
+    problem = display_problem()
+    if problem is not None:
+        raise RuntimeError(f"pvpython cannot draw: {problem}")
     for _ in range(max(1, int(attempts))):
         proc = _run_once(cmd, timeout, capture)
         if not _x_failed(proc):
@@ -286,6 +304,12 @@ def main(argv=None):
         print(f"pvpython is not on PATH. With ParaView installed: pvpython {script} "
               f"(headless: xvfb-run -a pvpython {script}), or open it in the GUI: "
               f"paraview --script={script}")
+        return 1
+    problem = display_problem()
+    if problem is not None:
+        print(f"tdem view: pvpython cannot draw: {problem}. The script is {script}: "
+              f"open it in the ParaView GUI with paraview --script={script}",
+              file=sys.stderr)
         return 1
     print(" ".join(view_command(d, rest)) + (" (on a virtual display)" if _headless()
                                                else ""), flush=True)

@@ -112,7 +112,29 @@ def test_tdem_view_without_pvpython_says_how(lattice, tmp_path, monkeypatch, cap
     assert settings(d / "view.py")["SERIES"]["contacts"] == "contacts.pvd"
 
 
-@pytest.mark.skipif(shutil.which("pvpython") is None, reason="ParaView (pvpython) not installed")
+def test_tdem_view_without_a_display_says_how(lattice, tmp_path, monkeypatch, capsys):
+    """Headless with ParaView but no Xvfb: pvpython would crash (SIGSEGV); tdem view
+    says what is missing instead, and rendering raises the same."""
+    sim, out = lattice
+    d = tmp_path / "copy"
+    shutil.copytree(out, d)
+    fake = tmp_path / "bin"
+    fake.mkdir()
+    (fake / "pvpython").write_text("#!/bin/sh\nexit 139\n")
+    (fake / "pvpython").chmod(0o755)
+    monkeypatch.setenv("PATH", str(fake))
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert not paraview.can_render()
+    assert cli(["view", str(d)]) == 1
+    err = capsys.readouterr().err
+    assert "no display" in err and "apt-get install xvfb" in err
+    with pytest.raises(RuntimeError, match="no Xvfb"):
+        paraview.render(d, ["--png", str(d / "v.png")])
+
+
+@pytest.mark.skipif(not paraview.can_render(), reason="ParaView (pvpython) with a display "
+                    "or Xvfb not installed")
 def test_pvpython_draws_discs_at_their_radius_and_tubes(lattice, tmp_path):
     sim, out = lattice
     W, H = 640, 480
@@ -187,7 +209,8 @@ def test_pvpython_draws_discs_at_their_radius_and_tubes(lattice, tmp_path):
     assert drawn == pytest.approx(expected, rel=0.05)
 
 
-@pytest.mark.skipif(shutil.which("pvpython") is None, reason="ParaView (pvpython) not installed")
+@pytest.mark.skipif(not paraview.can_render(), reason="ParaView (pvpython) with a display "
+                    "or Xvfb not installed")
 def test_tdem_view_renders_the_png(lattice, capsys):
     sim, out = lattice
     png = out / "view.png"
