@@ -359,7 +359,13 @@ class Fluid(Material):
     the water's area grows (7 % by T = 2.5 incremental, 4 % equation of state) as
     the particles of the thinning front spread apart. Both lose volume
     when a random packing flows (the area of deleted triangles is not
-    returned to anyone), so water is best packed on a lattice.
+    returned to anyone), so water is best packed on a lattice. The same dam break
+    packed otherwise (incremental pressure; measured 2026-12-05), its front against
+    Martin & Moyce at T = 0.83, 1.22, 2.0, 2.55, 3.3: random discs of 0.8–1.2 R at
+    80 % (``tdem.pack.random``) +7.8, +4.7, −5.4, −10.6, −14.7 %; the same at 89 %
+    with the holes of the element cover filled (``overlap_tol=0.7``,
+    ``pcmm_tolerance=R``) +22, +23, +7, −3, −14 %; hexagonal lattice +0.3, −3, −27,
+    −38, −42 %.
 
     Packings other than the square lattice, measured (0.3 × 0.5 m column, R = 5
     mm, K = ρ(10·sqrt(2gh))² = 0.98 MPa, μ = 1 Pa·s, frictionless walls, local
