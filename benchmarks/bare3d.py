@@ -3,7 +3,9 @@
 One Taichi kernel with nothing but the physics of the workload (``pack3d.py``): the
 Hertz–Mindlin pair force with its shear spring turned onto the tangent plane and the
 Coulomb limit (the formulas of ``physics.hertz_mindlin``, its constants folded in at
-compile time), each pair once with the partner's share added on the spot (one thread),
+compile time; the turned spring's length always restored by the series the engine uses
+for small turns), each pair once with the partner's share added on the spot (a serial
+loop: one thread, whatever ``--threads`` says),
 the five walls as planes (without shear springs), and a plain leapfrog. Left out,
 against the engine's step: the energy and work account, the orientations, the law and
 shape dispatch (per-pair radii, masses and law parameters), mesh walls, damping and
