@@ -438,7 +438,9 @@ class Fluid(Material):
     Fluid's front on the hexagonal lattice lags by 0–42 %, on the square lattice it
     keeps within 2 %.) So the option suits a slow, viscous body or a reservoir at
     rest; water that must both rest and flow on a hexagonal packing it does not give.
-    Nor does a wider Eq. 1 tolerance: with δ = 1.5 or 1.8 R the hexagonal lattice's
+    The same relaxing shear stress on the equation of state's nodal pressure (tried,
+    not offered): 9e-3 m/s at τ = 0.1 s with single pressures of 0.3–1.6 ρgd and 1 %
+    more elements, 0.08 m/s at τ = 0.01 s. Nor does a wider Eq. 1 tolerance: with δ = 1.5 or 1.8 R the hexagonal lattice's
     second ring of neighbours joins the elements (11,900 against 9,576), and the plain
     Fluid column still moves at 0.2 m/s with single pressures of −1.4 to 2.6 ρgd.
 
