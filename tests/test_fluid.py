@@ -321,3 +321,30 @@ def test_maxwell_water_restarts_bitwise(tmp_path):
     ea, eb = sim.elements.numpy(), sim2.elements.numpy()
     assert float(np.abs(ea["stress"][:, 0, 1]).max()) > 1.0    # shear stress carried (Pa)
     assert np.array_equal(ea["stress"], eb["stress"])
+
+
+def test_maxwell_shear_stress_grows_and_relaxes():
+    """The Maxwell fluid's law on a square patch (K = 1 MPa, G_s = 10 kPa, τ = 10 ms)
+    sheared at a prescribed rate γ̇ = 0.05 /s for 30 ms, then held still: the shear
+    stress of every triangle follows G_s·γ̇·τ·(1 − e^(−t/τ)) (within 1 %; measured
+    −0.4 %, the step's first-order lag) and, once the particles stop, decays by
+    exp(−n·Δt/τ) over n steps (to round-off); the mean stress stays zero."""
+    k, gs, tau, rate, t1 = 1e6, 1e4, 0.01, 0.05, 0.03
+    water = tdem.Fluid(density=RHO, bulk_modulus=k, shear_modulus=gs, relaxation_time=tau)
+    sim = tdem.Simulation(gravity=(0.0, 0.0), progress=False)
+    pos, r = tdem.pack.regular(0.1, 0.1, R)
+    g = sim.add_particles(pos, r, material=water, tolerance=R)
+    y = pos[:, 1]
+    sim.fix_particles(g.ids, vx=lambda t: rate * y if t < t1 else 0.0 * y, vy=0.0)
+    sim.run(until=t1)
+    s = sim.elements.numpy()["stress"]
+    assert len(s) > 100
+    assert s[:, 0, 1] == pytest.approx(gs * rate * tau * (1.0 - math.exp(-sim.time / tau)),
+                                       rel=0.01)
+    assert np.abs(s[:, 0, 0] + s[:, 1, 1]).max() < 1e-6 * gs * rate * tau
+    sim.run(steps=5)                     # the held particles' last strain increment
+    a = sim.elements.numpy()["stress"][:, 0, 1]
+    n = 200
+    sim.run(steps=n)
+    b = sim.elements.numpy()["stress"][:, 0, 1]
+    np.testing.assert_allclose(b / a, math.exp(-n * sim.dt / tau), rtol=1e-9)
