@@ -423,9 +423,9 @@ class Fluid(Material):
     52 ρgR rms, ±4.8 ρgR of it between the lattice's up and down triangles, and that
     departure pushes the interior particles with 0.09 N/m (median; 0.41 at most),
     against 26 N/m for an unbalanced pattern of its size: a particle's weight is 0.77
-    N/m; a particle's pressure is the mean over its triangles, and reads the pattern). An elastic solid of the
-    same G scatters less but carries the lateral stress of a confined solid (ν/(1 − ν)
-    of the vertical), not a hydrostatic one. On the random packing (radii 0.8–1.2 R,
+    N/m; a particle's pressure is the mean over its triangles, and reads the
+    pattern). An elastic solid of the same G scatters less but carries the lateral
+    stress of a confined solid (ν/(1 − ν) of the vertical), not a hydrostatic one. On the random packing (radii 0.8–1.2 R,
     80 % of the area) the Maxwell fluid still flows (0.13–0.3 m/s): its triangles do
     not tile the body, and the shear stiffness cannot hold the push below.
 
@@ -440,9 +440,10 @@ class Fluid(Material):
     rest; water that must both rest and flow on a hexagonal packing it does not give.
     The same relaxing shear stress on the equation of state's nodal pressure (tried,
     not offered): 9e-3 m/s at τ = 0.1 s with single pressures of 0.3–1.6 ρgd and 1 %
-    more elements, 0.08 m/s at τ = 0.01 s. Nor does a wider Eq. 1 tolerance: with δ = 1.5 or 1.8 R the hexagonal lattice's
-    second ring of neighbours joins the elements (11,900 against 9,576), and the plain
-    Fluid column still moves at 0.2 m/s with single pressures of −1.4 to 2.6 ρgd.
+    more elements, 0.08 m/s at τ = 0.01 s. Nor does a wider Eq. 1 tolerance: with
+    δ = 1.5 or 1.8 R the hexagonal lattice's second ring of neighbours joins the
+    elements (11,900 against 9,576), and the plain Fluid column still moves at 0.2
+    m/s with single pressures of −1.4 to 2.6 ρgd.
 
     What would hold on any packing is an element system that tiles (a Delaunay
     triangulation of the centres within the Eq. 1 distance, kept by edge flips)

@@ -52,10 +52,7 @@ def column():
     sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5, local_damping=0.7)
     pos, r = tdem.pack.regular(W, H, R)
     g = sim.add_particles(pos, r, material=water, tolerance=R)
-    wall = tdem.LinearContact(kn=3.0 * K, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (W, 0.0), contact=wall)
-    sim.add_wall((0.0, 2 * H), (0.0, 0.0), contact=wall)
-    sim.add_wall((W, 0.0), (W, 2 * H), contact=wall)
+    tank(sim, W, 2 * H, K)
     sim.run(until=0.3)
     sim.local_damping = 0.0
     t0 = sim.time
@@ -68,6 +65,15 @@ def column():
         errs_edge.append(pressure_errors(p, R, 0.24))
     return {"n": len(g.ids), "vmax": np.array(vmax), "err": np.array(errs),
             "err_edge": np.array(errs_edge)}
+
+
+def tank(sim, width, height, k):
+    """The tank's floor and sides, ``width`` apart and ``height`` high: frictionless
+    walls of the particle–wall law k_n = 3K (the water's bulk modulus K = ``k``)."""
+    wall = tdem.LinearContact(kn=3.0 * k, ks=0.0, friction=0.0)
+    sim.add_wall((0.0, 0.0), (width, 0.0), contact=wall)
+    sim.add_wall((0.0, height), (0.0, 0.0), contact=wall)
+    sim.add_wall((width, 0.0), (width, height), contact=wall)
 
 
 def pressure_errors(p, above, dmin):
@@ -171,10 +177,7 @@ def test_dam_break():
     sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5)
     pos, r = tdem.pack.regular(a, h, R)
     sim.add_particles(pos, r, material=water, tolerance=R)
-    wall = tdem.LinearContact(kn=3.0 * K, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (1.5, 0.0), contact=wall)
-    sim.add_wall((0.0, 1.0), (0.0, 0.0), contact=wall)
-    sim.add_wall((1.5, 0.0), (1.5, 1.0), contact=wall)
+    tank(sim, 1.5, 1.0, K)
     sim.run(steps=1)
     e0 = sim.energy()
     total0 = e0["kinetic"] + e0["gravitational"]
@@ -237,10 +240,7 @@ def hex_column(**shear):
                           progress=False)
     pos, rad = tdem.pack.cross(w, h, r)
     sim.add_particles(pos, rad, material=water, tolerance=r)
-    wall = tdem.LinearContact(kn=3.0 * k, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (w, 0.0), contact=wall)
-    sim.add_wall((0.0, 2 * h), (0.0, 0.0), contact=wall)
-    sim.add_wall((w, 0.0), (w, 2 * h), contact=wall)
+    tank(sim, w, 2 * h, k)
     sim.run(until=0.3)
     sim.local_damping = 0.0
 
@@ -304,10 +304,7 @@ def test_maxwell_water_restarts_bitwise(tmp_path):
     sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5, progress=False)
     pos, r = tdem.pack.cross(0.2, 0.2, R)
     sim.add_particles(pos, r, material=water, tolerance=R)
-    wall = tdem.LinearContact(kn=3.0 * k, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (0.4, 0.0), contact=wall)
-    sim.add_wall((0.0, 1.0), (0.0, 0.0), contact=wall)
-    sim.add_wall((0.4, 0.0), (0.4, 1.0), contact=wall)
+    tank(sim, 0.4, 1.0, k)
     sim.run(steps=400)
     sim.save(tmp_path / "w.h5")
     sim.run(steps=400)
