@@ -131,6 +131,64 @@ SERIAL_BELOW_DEM = 12000
 SERIAL_BELOW_ELEMENTS = 2000
 
 
+# On several CPU threads the step's pair loop runs in chunks, each chunk of particles
+# one thread's serial loop (tdem.step.step): a pair within a chunk gives the partner
+# its share at once, as on one thread, and only pairs across chunks go through their
+# slot and the gather (with a slot for every pair, as on a GPU, the step costs 1.8
+# times the one-thread step's work: benchmarks/RESULTS.md). CHUNKS_PER_THREAD chunks
+# per thread share the work out; fewer, larger chunks leave fewer pairs across them.
+CHUNKS_PER_THREAD = 4
+# ... but no chunk smaller than this unless TDEM_CHUNKS asks: each chunk beyond the
+# first wakes a thread (about 50 us a step on 2 threads), which a small model's
+# step does not repay
+MIN_CHUNK = 1024
+
+
+def _chunks_asked():
+    env = os.environ.get("TDEM_CHUNKS")
+    if not env:
+        return None
+    try:
+        k = int(env)
+    except ValueError:
+        k = -1
+    if k < 0:
+        raise InputError(f"TDEM_CHUNKS must be a whole number >= 0, got {env!r}")
+    return k
+
+
+def chunks_wanted():
+    """Chunks of the step's pair loop on several CPU threads: ``$TDEM_CHUNKS`` (0: a
+    slot for every pair, the GPU's path), else CHUNKS_PER_THREAD × threads."""
+    k = _chunks_asked()
+    if k is not None:
+        return k
+    return CHUNKS_PER_THREAD * max(int(_state["nthreads"] or 1), 1)
+
+
+def max_chunks():
+    """Rows of the walls' partial sums: the most chunks :func:`chunk_size` gives."""
+    return max(chunks_wanted(), 1)
+
+
+def chunk_size(n, serial):
+    """Particles per chunk of the step's pair loop for a model of n particles: 0 on
+    one thread (``serial``) and on a GPU (every pair through its slot), else
+    n / :func:`chunks_wanted`, rounded up, and at least MIN_CHUNK unless
+    ``$TDEM_CHUNKS`` asks (one chunk: the one-thread order on one thread). The result depends on the chunks (the
+    order in which pairs across them are summed), not on which thread runs which: a
+    run repeats itself bit for bit with the same chunks, and runs with other chunks
+    agree to round-off. ``$TDEM_CHUNKS=K`` fixes the count whatever the threads."""
+    if serial or _state["arch"] != "cpu":
+        return 0
+    k = chunks_wanted()
+    if k == 0:
+        return 0
+    if _chunks_asked() is None:
+        k = min(k, max(int(n) // MIN_CHUNK, 1))
+    return max(1, -(-int(n) // k))
+
+
 def serial_below(elements=False):
     """The model size below which :func:`serial_loops` says yes, for the threads in
     use. With T threads a loop of n items takes n·c/T + D instead of n·c (D: waking

@@ -52,6 +52,7 @@ FLAGS_SIZE = 9
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
 P_PX0, P_PLX, P_PY0, P_PLY = 7, 8, 9, 10      # periodic axes: start, length (0: none)
 P_GZ, P_PZ0, P_PLZ = 11, 12, 13                # 3D: gravity, periodic z axis
+P_CHUNK = 14                                    # particles per chunk of the step's pair loop
 SIMP_SIZE = 16
 
 

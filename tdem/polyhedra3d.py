@@ -228,7 +228,7 @@ def poly_pair(i, k, xi, vi, wi, mi, li, pos: ti.template(), vel: ti.template(),
 @ti.func
 def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
                   prop: ti.template(), angle: ti.template(), shp: ti.template(),
-                  wall: ti.template(), wforce: ti.template(), lawp: ti.template(),
+                  wall: ti.template(), wpart: ti.template(), row, lawp: ti.template(),
                   wid: ti.template(), whist: ti.template(), wcn: ti.template(),
                   wcf: ti.template(), wcs: ti.template(), flags: ti.template(), dt,
                   laws: ti.template(), ptab: ti.template(), pint: ti.template()):
@@ -298,9 +298,9 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             mtot += mo
             tw = moment(cen - o, -f)
             for q in ti.static(range(3)):
-                ti.atomic_add(wforce[w][q], -f[q])
-                ti.atomic_add(wforce[w][3 + q], tw[q])
-            ti.atomic_add(wforce[w][6], 1.0)
+                ti.atomic_add(wpart[row, w][q], -f[q])
+                ti.atomic_add(wpart[row, w][3 + q], tw[q])
+            ti.atomic_add(wpart[row, w][6], 1.0)
         elif h.dot(h) != 0.0 or wcs[i, s][2] > 0.0:
             whist[i, s] = zero_history(h)
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])

@@ -111,6 +111,7 @@ class Runner:
     def _sizes(self, n, cap, capw, nwalls, nlaws, ncell):
         """The sizes :func:`tdem.state.allocate` takes, for this model."""
         return {"n": n, "cap": cap, "capw": capw, "walls": max(nwalls, 1), "laws": nlaws,
+                "chunks": backend.max_chunks(),
                 "law_width": _claw.table_width(self._law_set), "cells": ncell,
                 "cell_starts": ncell + 4096, "flags": FLAGS_SIZE, "simp": stepk.SIMP_SIZE,
                 "tcells": ncell if self.dim == 3 else 1,
@@ -523,8 +524,12 @@ class Runner:
     def _step_args(self):
         # the arrays by name; _one_step appends the last five (detail, continuum, laws,
         # shapes, dim)
-        return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
-                           loads=bool(self._loads_on), detail=False, continuum=False,
+        serial = self._serial()
+        chunk = backend.chunk_size(self._n, serial)
+        if chunk:
+            self._a["simp"][stepk.P_CHUNK] = chunk
+        return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=serial,
+                           chunk=chunk > 0, loads=bool(self._loads_on), detail=False, continuum=False,
                            laws=self._law_set, shapes=False, dim=self.dim)[:-5]
 
     def _xforce(self):

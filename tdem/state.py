@@ -15,8 +15,8 @@ saves them); ``setup`` arrays are set by the host between runs (saved, not in th
 snapshot); ``scratch`` arrays are rebuilt whenever needed (neither).
 
 Owners and their shapes: ``particle`` (n,), ``slot`` (n, cap) the half neighbour
-list, ``wall_slot`` (n, capw) a particle's candidate walls, ``wall`` (walls,), and
-fixed-size tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's
+list, ``wall_slot`` (n, capw) a particle's candidate walls, ``wall`` (walls,),
+``wall_part`` (chunks, walls) per chunk of the step's pair loop, and fixed-size tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's
 or a wall contact's history vector (as wide as the registered contact laws need,
 :mod:`physics.contact_law`).
 
@@ -38,7 +38,7 @@ from .launch import cached
 @dataclass(frozen=True)
 class Array:
     name: str
-    owner: str            # particle | slot | wall_slot | wall | table
+    owner: str            # particle | slot | wall_slot | wall | wall_part | table
     comps: object         # 0 scalar, k vector, "H" / "HW" history, (a, b) a 2-d table row
     dtype: str            # "f": the simulation's precision, "f64", "i32"
     role: str             # dynamic | setup | scratch
@@ -110,6 +110,8 @@ ENGINE = (
     Array("wall", "table", ("walls", "wall_width"), "f64", "dynamic", doc="wall rows (step.W_*)"),
     Array("wforce", "wall", {2: 4, 3: 7}, "f64", "dynamic",
           doc="force, moment about the wall's centre, contacts received"),
+    Array("wpart", "wall_part", {2: 4, 3: 7}, "f64", "scratch",
+          doc="wforce's partial sums, one row per chunk of the step's pair loop"),
     Array("lawp", "table", ("laws", "law_width"), "f64", "scratch", doc="law parameters"),
     Array("lawpair", "table", ("laws", "laws"), "i32", "scratch", doc="law of a pair of groups"),
     Array("flags", "table", ("flags",), "i32", "dynamic", doc="status word (neighbors.F_*)"),
@@ -191,7 +193,7 @@ def shape(a, sizes):
         return tuple(derived[s] if s in derived else sizes[s] if isinstance(s, str) else s
                      for s in a.comps), None
     lead = {"particle": ("n",), "slot": ("n", "cap"), "wall_slot": ("n", "capw"),
-            "wall": ("walls",)}[a.owner]
+            "wall": ("walls",), "wall_part": ("chunks", "walls")}[a.owner]
     comps = _comps(a, sizes)
     return tuple(sizes[s] for s in lead), (None if comps in (0, "i") else comps)
 

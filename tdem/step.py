@@ -2,7 +2,8 @@
 
     forces at x_n (pair contacts from the neighbour lists, wall contacts),
       summed per owner particle; the partner's share goes straight to its sum on
-      one thread, or stays in the pair's slot when threads run in parallel
+      one thread and within a CPU thread's chunk of particles, or stays in the
+      pair's slot across chunks and on a GPU
       -> gather per particle (own sum + reverse slots: no atomics, fixed order)
       -> damping, prescribed velocities, leapfrog: v_{n+1/2}, x_{n+1}
       -> energy account at t_n, skin check (raises the rebuild flag)
@@ -27,10 +28,11 @@ from physics.rolling import (rolling_couple, rolling_couple_3d, rolling_energy,
 from .finite import any_non_finite, non_finite
 from .integrate import _quat_mul, damped_leapfrog, free_rotation
 from .launch import cached
-from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_DT, P_GX, P_GY,  # noqa: F401
-                        P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0, P_PZ0, P_SKIN,
-                        SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH, T_OX, T_VX, T_WX,
-                        TRI_WIDTH, gravity, image, periodic_axes, slot_bits, tri_vec)
+from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_CHUNK,  # noqa: F401
+                        P_DT, P_GX, P_GY, P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0,
+                        P_PZ0, P_SKIN, SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH,
+                        T_OX, T_VX, T_WX, TRI_WIDTH, gravity, image, periodic_axes, slot_bits,
+                        tri_vec)
 from . import polyhedra3d, shaped3d
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
@@ -167,13 +169,14 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
 
 @ti.func
 def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
-                  prop: ti.template(), wall: ti.template(), wforce: ti.template(),
+                  prop: ti.template(), wall: ti.template(), wpart: ti.template(), row,
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
                   wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
                   laws: ti.template(), angle: ti.template(), shp: ti.template(),
                   flags: ti.template(), shapes: ti.template()):
     """Contacts of particle i with its candidate walls (listed in its wall slots by the
-    neighbour build). The wall is 'j', of infinite radius and mass. Returns
+    neighbour build). The wall is 'j', of infinite radius and mass; what it receives
+    is added to its sum in row ``row`` of ``wpart`` (the chunk's). Returns
     (force on i, moment on i, dissipation, work done by the walls). The history holds
     the law's columns, then the rolling couple, rotation and broken flag."""
     R = ti.static(history_width(laws))
@@ -213,10 +216,10 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                 ftot += f
                 mtot += mi
                 r = xc - c
-                ti.atomic_add(wforce[w][0], -f[0])
-                ti.atomic_add(wforce[w][1], -f[1])
-                ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]))
-                ti.atomic_add(wforce[w][3], 1.0)
+                ti.atomic_add(wpart[row, w][0], -f[0])
+                ti.atomic_add(wpart[row, w][1], -f[1])
+                ti.atomic_add(wpart[row, w][2], r[0] * (-f[1]) - r[1] * (-f[0]))
+                ti.atomic_add(wpart[row, w][3], 1.0)
             elif wcs[i, s][2] > 0.0:
                 wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
                 wcs[i, s] = ti.Vector([0.0, 0.0, u])
@@ -248,10 +251,10 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             ftot += f
             mtot += mi
             r = xc - c
-            ti.atomic_add(wforce[w][0], -f[0])
-            ti.atomic_add(wforce[w][1], -f[1])
-            ti.atomic_add(wforce[w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
-            ti.atomic_add(wforce[w][3], 1.0)
+            ti.atomic_add(wpart[row, w][0], -f[0])
+            ti.atomic_add(wpart[row, w][1], -f[1])
+            ti.atomic_add(wpart[row, w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
+            ti.atomic_add(wpart[row, w][3], 1.0)
         elif whist[i, s][0] != 0.0 or wcs[i, s][2] > 0.0 or whist[i, s][R] != 0.0:
             whist[i, s] = zero_history(whist[i, s])
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
@@ -288,7 +291,7 @@ def _mesh_geometry(xi, ri, shaped, mat, abc, wall: ti.template(), w):
 
 @ti.func
 def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
-                  prop: ti.template(), wall: ti.template(), wforce: ti.template(),
+                  prop: ti.template(), wall: ti.template(), wpart: ti.template(), row,
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
                   wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
                   laws: ti.template(), shaped, mat, abc):
@@ -300,7 +303,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
     border), and of several edge or vertex contacts at one point the first is kept:
     a particle on the seams of a flat or convex surface feels one plane. A contact that
     moves to a neighbouring triangle of the same mesh takes its shear spring along.
-    Returns (force, moment, dissipation, work of the walls) as :func:`wall_contacts`.
+    Returns (force, moment, dissipation, work of the walls) and adds what the walls
+    receive to ``wpart`` as :func:`wall_contacts`.
     An ellipsoid's wall history keeps its Hertz radius after the law's columns."""
     T = ti.static(tangent_dim(3))
     RW = ti.static(history_width(laws, T))
@@ -388,9 +392,9 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             mtot += mi
             tw = moment(point - c, -f) - m_roll
             for k in ti.static(range(3)):
-                ti.atomic_add(wforce[w][k], -f[k])
-                ti.atomic_add(wforce[w][3 + k], tw[k])
-            ti.atomic_add(wforce[w][6], 1.0)
+                ti.atomic_add(wpart[row, w][k], -f[k])
+                ti.atomic_add(wpart[row, w][3 + k], tw[k])
+            ti.atomic_add(wpart[row, w][6], 1.0)
         elif get_first(h, T) != 0.0 or wcs[i, s][2] > 0.0:
             whist[i, s] = zero_history(h)
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
@@ -435,13 +439,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
          cn: ti.types.ndarray(), cf: ti.types.ndarray(), cs: ti.types.ndarray(),
          rev: ti.types.ndarray(), rcnt: ti.types.ndarray(),
-         wall: ti.types.ndarray(), wforce: ti.types.ndarray(),
+         wall: ti.types.ndarray(), wforce: ti.types.ndarray(), wpart: ti.types.ndarray(),
          wid: ti.types.ndarray(), whist: ti.types.ndarray(), wcn: ti.types.ndarray(),
          wcf: ti.types.ndarray(), wcs: ti.types.ndarray(),
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
          fext: ti.types.ndarray(), lmom: ti.types.ndarray(), ptab: ti.types.ndarray(),
-         pint: ti.types.ndarray(), serial: ti.template(),
+         pint: ti.types.ndarray(), serial: ti.template(), chunk: ti.template(),
          loads: ti.template(),
          detail: ti.template(), continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
@@ -454,6 +458,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     of this step (``xforce``, from :func:`physics.pcmm.update`) join the contact
     forces, and pair slots marked in ``cskip`` (particles that share an element)
     have no DEM contact.
+
+    ``serial`` (compile-time): every loop on one thread. ``chunk`` (compile-time):
+    the pair loop in chunks, each one thread's serial loop (1. below).
 
     ``loads`` (compile-time): applied forces and moments (``fext``, from
     :meth:`tdem.Simulation.apply_force`) act on the particles.
@@ -475,10 +482,6 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     half_skin2 = (0.5 * simp[P_SKIN]) ** 2
     per = periodic_axes(simp, dim)
 
-    ti.loop_config(serialize=True)
-    for w in range(nw):
-        wforce[w] = wforce[w] * 0.0
-
     if ti.static(shapes and dim == 2):
         # each angle's cosine and sine once, for all the pairs it takes part in
         ti.loop_config(serialize=serial)
@@ -487,132 +490,160 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
 
     # 1. contact forces at x_n: each pair once, by its owner (the lower index). On one
     #    thread the partner's share goes straight into its sum; in parallel it is kept
-    #    in the slot and gathered in 2. (no atomics, a fixed summation order).
+    #    in the slot and gathered in 2. (no atomics, a fixed summation order). With
+    #    ``chunk`` (CPU threads) each chunk of simp[P_CHUNK] particles is one thread's
+    #    serial loop: a partner in the same chunk gets its share at once, one in a
+    #    later chunk through the slot. Otherwise each particle is its own chunk.
+    #    (Taichi's CPU tasks take at least 512 iterations of a parallel loop, so a
+    #    loop over a dozen chunks would run on one thread: the loop gives each of
+    #    several chunks 2^sp iterations, the first of which does its work.)
+    csz = 1
+    sp = 0
+    if ti.static(chunk):
+        csz = ti.cast(simp[P_CHUNK], ti.i32)
+        if csz < n:
+            sp = 10
     ti.loop_config(serialize=serial)
-    for i in range(n):
-        f = vec_zero(dim)
-        tq = spin_zero(dim)
-        diss = 0.0
-        xi = pos[i]
-        vi = vel[i]
-        wi = omega[i]
-        pi = prop[i]
-        li = plaw[i]
-        shi = ti.Vector([0.0, 0.0, 0.0])
-        ishaped = False
-        cthi = 1.0
-        sthi = 0.0
-        mati = ti.Matrix.identity(float, 3)
-        if ti.static(shapes and dim == 2):
-            cthi = turn[i][0]
-            sthi = turn[i][1]
-            shi = shape_of(shp[i], pi[PROP_RADIUS])
-            ishaped = shp[i][2] > 0.0
-        ipoly = False
-        if ti.static(dim == 3 and (shapes & SHAPES_SMOOTH)):
-            # an ellipsoid's semi-axes and shape matrix (a sphere's: r, r, r)
-            shi = shaped3d.axes_of(shp[i], pi[PROP_RADIUS])
-            mati = shaped3d.el.shape_matrix(shaped3d.frame_of(shp[i], angle[i]), shi)
-            ishaped = shp[i][3] > 0.0
-        if ti.static(dim == 3 and (shapes & SHAPES_POLY)):
-            ipoly = shp[i][3] < 0.0
-        for k in range(ncnt[i]):
-            fk = vec_zero(dim)
-            mk = spin_zero(dim)
-            mjk = spin_zero(dim)
-            dk = 0.0
-            skip = 0
-            if ti.static(continuum):
-                skip = cskip[i, k]
-            if skip == 1:
-                # the elements carry this pair (its history is kept by
-                # physics.pcmm.gather)
-                if ti.static(detail):
-                    cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
-            else:
-                if skip == 2:
-                    # a same-body pair at the start: the contact law counts from now
-                    j = nbr[i, k]
-                    u = pi[PROP_RADIUS] + prop[j][PROP_RADIUS] - (pos[j] - xi).norm()
-                    h0 = hist[i, k]
-                    h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
-                    hist[i, k] = h0
-                shaped = False
-                if ti.static(shapes and dim == 2):
-                    shaped = ishaped or shp[nbr[i, k]][2] > 0.0
-                if ti.static(shapes and dim == 3):
-                    # by the kinds of the two: a polyhedron, an ellipsoid, two spheres
-                    done = False
-                    if ti.static(shapes & SHAPES_POLY):
-                        if ipoly or shp[nbr[i, k]][3] < 0.0:
-                            fk, mk, mjk, dk = polyhedra3d.poly_pair(
-                                i, k, xi, vi, wi, pi[PROP_MASS], li, pos, vel, omega, prop,
-                                plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs, flags, dt,
-                                detail, laws, per, ptab, pint)
-                            done = True
-                    if ti.static(shapes & SHAPES_SMOOTH):
-                        if not done and (ishaped or shp[nbr[i, k]][3] > 0.0):
-                            fk, mk, mjk, dk = shaped3d.ellipsoid_pair(
-                                i, k, xi, vi, wi, pi[PROP_MASS], li, mati, shi, pos, vel,
-                                omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs,
-                                flags, dt, detail, laws, per)
-                            done = True
-                    if not done:
+    for cs_ in range(((n + csz - 1) // csz) << sp):
+        lo = (cs_ >> sp) * csz
+        row = 0         # the chunk's row of the walls' partial sums
+        if ti.static(chunk):
+            row = cs_ >> sp
+        end = ti.min(n, lo + csz)
+        if cs_ & ((1 << sp) - 1) != 0:
+            end = lo
+        for i in range(lo, end):
+            f = vec_zero(dim)
+            tq = spin_zero(dim)
+            diss = 0.0
+            xi = pos[i]
+            vi = vel[i]
+            wi = omega[i]
+            pi = prop[i]
+            li = plaw[i]
+            shi = ti.Vector([0.0, 0.0, 0.0])
+            ishaped = False
+            cthi = 1.0
+            sthi = 0.0
+            mati = ti.Matrix.identity(float, 3)
+            if ti.static(shapes and dim == 2):
+                cthi = turn[i][0]
+                sthi = turn[i][1]
+                shi = shape_of(shp[i], pi[PROP_RADIUS])
+                ishaped = shp[i][2] > 0.0
+            ipoly = False
+            if ti.static(dim == 3 and (shapes & SHAPES_SMOOTH)):
+                # an ellipsoid's semi-axes and shape matrix (a sphere's: r, r, r)
+                shi = shaped3d.axes_of(shp[i], pi[PROP_RADIUS])
+                mati = shaped3d.el.shape_matrix(shaped3d.frame_of(shp[i], angle[i]), shi)
+                ishaped = shp[i][3] > 0.0
+            if ti.static(dim == 3 and (shapes & SHAPES_POLY)):
+                ipoly = shp[i][3] < 0.0
+            for k in range(ncnt[i]):
+                fk = vec_zero(dim)
+                mk = spin_zero(dim)
+                mjk = spin_zero(dim)
+                dk = 0.0
+                skip = 0
+                if ti.static(continuum):
+                    skip = cskip[i, k]
+                if skip == 1:
+                    # the elements carry this pair (its history is kept by
+                    # physics.pcmm.gather)
+                    if ti.static(detail):
+                        cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
+                else:
+                    if skip == 2:
+                        # a same-body pair at the start: the contact law counts from now
+                        j = nbr[i, k]
+                        u = pi[PROP_RADIUS] + prop[j][PROP_RADIUS] - (pos[j] - xi).norm()
+                        h0 = hist[i, k]
+                        h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
+                        hist[i, k] = h0
+                    shaped = False
+                    if ti.static(shapes and dim == 2):
+                        shaped = ishaped or shp[nbr[i, k]][2] > 0.0
+                    if ti.static(shapes and dim == 3):
+                        # by the kinds of the two: a polyhedron, an ellipsoid, two spheres
+                        done = False
+                        if ti.static(shapes & SHAPES_POLY):
+                            if ipoly or shp[nbr[i, k]][3] < 0.0:
+                                fk, mk, mjk, dk = polyhedra3d.poly_pair(
+                                    i, k, xi, vi, wi, pi[PROP_MASS], li, pos, vel, omega, prop,
+                                    plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs, flags, dt,
+                                    detail, laws, per, ptab, pint)
+                                done = True
+                        if ti.static(shapes & SHAPES_SMOOTH):
+                            if not done and (ishaped or shp[nbr[i, k]][3] > 0.0):
+                                fk, mk, mjk, dk = shaped3d.ellipsoid_pair(
+                                    i, k, xi, vi, wi, pi[PROP_MASS], li, mati, shi, pos, vel,
+                                    omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs,
+                                    flags, dt, detail, laws, per)
+                                done = True
+                        if not done:
+                            fk, mk, mjk, dk = pair_contact(
+                                i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel,
+                                omega, prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail,
+                                laws, per)
+                    elif ti.static(shapes):
+                        if shaped:
+                            fk, mk, mjk, dk = shaped_pair(
+                                i, k, xi, vi, wi, pi[PROP_MASS], li, cthi, sthi, shi,
+                                pi[PROP_RADIUS], pos, vel, omega, prop, plaw, turn, shp, lawp,
+                                lawpair, nbr, hist, cn, cs, flags, dt, detail, laws, per)
+                        else:
+                            fk, mk, mjk, dk = pair_contact(
+                                i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel,
+                                omega, prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail,
+                                laws, per)
+                    else:
                         fk, mk, mjk, dk = pair_contact(
                             i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
                             prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws, per)
-                elif ti.static(shapes):
-                    if shaped:
-                        fk, mk, mjk, dk = shaped_pair(
-                            i, k, xi, vi, wi, pi[PROP_MASS], li, cthi, sthi, shi, pi[PROP_RADIUS],
-                            pos, vel, omega, prop, plaw, turn, shp, lawp, lawpair, nbr, hist,
-                            cn, cs, flags, dt, detail, laws, per)
-                    else:
-                        fk, mk, mjk, dk = pair_contact(
-                            i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel,
-                            omega, prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail,
-                            laws, per)
-                else:
-                    fk, mk, mjk, dk = pair_contact(
-                        i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
-                        prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws, per)
-            f += fk
-            tq += mk
-            diss += dk
-            if ti.static(serial):
-                if skip != 1:
-                    j = nbr[i, k]
-                    facc[j] += pack(-fk, mjk, dim)
-            if ti.static(detail):
-                cf[i, k] = pack(fk, mjk, dim)
-            elif ti.static(not serial):
-                if skip != 1:      # (a carried pair's share is not read, see 2.)
+                f += fk
+                tq += mk
+                diss += dk
+                if ti.static(serial):
+                    if skip != 1:
+                        j = nbr[i, k]
+                        facc[j] += pack(-fk, mjk, dim)
+                elif ti.static(chunk):
+                    if skip != 1:
+                        j = nbr[i, k]
+                        if j < end:
+                            facc[j] = facc[j] + pack(-fk, mjk, dim)
+                        elif ti.static(not detail):
+                            cf[i, k] = pack(fk, mjk, dim)
+                if ti.static(detail):
                     cf[i, k] = pack(fk, mjk, dim)
-        fw = vec_zero(dim)
-        mw = spin_zero(dim)
-        dw = 0.0
-        work = 0.0
-        if ti.static(dim == 2):
-            fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wforce, lawp, wid,
-                                             whist, wcn, wcf, wcs, dt, laws, angle, shp, flags,
-                                             shapes)
-        else:
-            if ti.static(shapes & SHAPES_POLY):
-                if ipoly:
-                    fw, mw, dw, work = polyhedra3d.mesh_contacts(
-                        i, pos, vel, omega, prop, angle, shp, wall, wforce, lawp, wid, whist,
-                        wcn, wcf, wcs, flags, dt, laws, ptab, pint)
-            if not ipoly:
-                fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wforce, lawp,
-                                                 wid, whist, wcn, wcf, wcs, dt, laws, ishaped,
-                                                 mati, shi)
-        own = pack(f + fw, tq + mw, dim)
-        if ti.static(serial):
-            facc[i] += own
-        else:
-            facc[i] = own
-        if diss != 0.0 or dw != 0.0 or work != 0.0:
-            eacc[i] += ti.Vector([diss + dw, work])
+                elif ti.static(not serial and not chunk):
+                    if skip != 1:      # (a carried pair's share is not read, see 2.)
+                        cf[i, k] = pack(fk, mjk, dim)
+            fw = vec_zero(dim)
+            mw = spin_zero(dim)
+            dw = 0.0
+            work = 0.0
+            if ti.static(dim == 2):
+                fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wpart, row,
+                                                 lawp, wid, whist, wcn, wcf, wcs, dt, laws, angle,
+                                                 shp, flags, shapes)
+            else:
+                if ti.static(shapes & SHAPES_POLY):
+                    if ipoly:
+                        fw, mw, dw, work = polyhedra3d.mesh_contacts(
+                            i, pos, vel, omega, prop, angle, shp, wall, wpart, row, lawp, wid,
+                            whist, wcn, wcf, wcs, flags, dt, laws, ptab, pint)
+                if not ipoly:
+                    fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wpart,
+                                                     row, lawp, wid, whist, wcn, wcf, wcs, dt,
+                                                     laws, ishaped, mati, shi)
+            own = pack(f + fw, tq + mw, dim)
+            if ti.static(serial or chunk):
+                facc[i] = facc[i] + own
+            else:
+                facc[i] = own
+            if diss != 0.0 or dw != 0.0 or work != 0.0:
+                eacc[i] = eacc[i] + ti.Vector([diss + dw, work])
 
     # 2. gather the partners' share, damp, integrate (leapfrog), skin check
     ti.loop_config(serialize=serial)
@@ -623,6 +654,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         # adds into them), whichever path the next step takes
         facc[i] = a * 0.0
         if ti.static(not serial):
+            lo_i = 0        # the first particle of i's chunk
+            if ti.static(chunk):
+                lo_i = i // csz * csz
             for r in range(rcnt[i]):
                 flat = rev[i, r]
                 j = flat >> bits
@@ -630,6 +664,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 carried = False
                 if ti.static(continuum):
                     carried = cskip[j, k] == 1
+                if ti.static(chunk):
+                    carried = carried or j >= lo_i     # added in 1.
                 if not carried:
                     cfk, cmk = unpack(cf[j, k], dim)
                     f -= cfk
@@ -739,9 +775,22 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         if dx.dot(dx) > half_skin2:
             flags[F_REBUILD] = 1
 
-    # 3. walls move: servo walls first set their speed from the force they received,
-    #    then rotation about their centre and translation; a wall that has moved half
-    #    the skin since the lists were built asks for a rebuild
+    # 3. each wall's force: its chunks' partial sums added in their order (a fixed
+    #    order, whichever thread ran a chunk). Then the walls move: servo walls first
+    #    set their speed from the force they received, then rotation about their
+    #    centre and translation; a wall that has moved half the skin since the lists
+    #    were built asks for a rebuild
+    rows = 1
+    if ti.static(chunk):
+        rows = (n + csz - 1) // csz
+    ti.loop_config(serialize=serial or chunk)
+    for w in range(nw):
+        s = wpart[0, w]
+        wpart[0, w] = s * 0.0
+        for r in range(1, rows):
+            s += wpart[r, w]
+            wpart[r, w] = s * 0.0
+        wforce[w] = s
     if ti.static(dim == 3):
         # (on one thread in the same serial task: a parallel loop over a few walls
         # costs more to launch than to run)

@@ -108,28 +108,39 @@ sim.add_wall((0.0, 1.0), (0.0, 0.0), contact=law)
 sim.add_wall((0.4, 0.0), (0.4, 1.0), contact=law)
 sim.run(steps=1500)
 np.save(sys.argv[1], sim.particles.numpy()["position"])
+print("chunk", tdem.backend.chunk_size(sim.n_particles, sim._serial()))
 """
 
 
 def test_one_thread_and_parallel_paths_agree(tmp_path):
-    """On one thread partner forces are summed directly, in parallel they are gathered
-    from the slots: the two summation orders agree to round-off (TDEM_SERIAL_BELOW=0:
-    the 225 discs would otherwise run their loops on one thread on both)."""
+    """On one thread partner forces are summed directly; on two threads, directly
+    within each thread's chunk of particles and through the slots across chunks; on
+    the GPU's path (TDEM_CHUNKS=0, run here on the CPU) through the slots for every
+    pair. The three summation orders agree to round-off, and each repeats itself bit
+    for bit (TDEM_SERIAL_BELOW=0: the 225 discs would otherwise run their loops on one
+    thread on all)."""
     import os
     import subprocess
     import sys
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     script = tmp_path / "pile.py"
     script.write_text(_PILE.format(root=root))
-    out = {}
-    for threads in ("1", "2"):
-        subprocess.run([sys.executable, str(script), str(tmp_path / f"{threads}.npy")],
-                       env=dict(os.environ, TDEM_THREADS=threads, TDEM_SERIAL_BELOW="0"),
-                       check=True,
-                       capture_output=True)
-        out[threads] = np.load(tmp_path / f"{threads}.npy")
+    out, chunk = {}, {}
+    for name, threads, chunks in (("one", "1", ""), ("chunks", "2", "8"),
+                                  ("chunks again", "2", "8"), ("slots", "2", "0")):
+        path = tmp_path / f"{name}.npy"
+        run = subprocess.run([sys.executable, str(script), str(path)],
+                             env=dict(os.environ, TDEM_THREADS=threads, TDEM_SERIAL_BELOW="0",
+                                      TDEM_CHUNKS=chunks),
+                             check=True, capture_output=True, text=True)
+        out[name] = np.load(path)
+        chunk[name] = int(run.stdout.split("chunk")[-1])
+    # 225 discs on two threads: 8 chunks of 29 (asked: a model this small has one)
+    assert chunk == {"one": 0, "chunks": 29, "chunks again": 29, "slots": 0}
     # a settling pile is chaotic: compare early enough that round-off has not grown
-    np.testing.assert_allclose(out["1"], out["2"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(out["chunks"], out["one"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(out["slots"], out["one"], rtol=0, atol=1e-9)
+    assert np.array_equal(out["chunks"], out["chunks again"])
 
 
 def test_device_side_rebuild_path_gives_the_same_run():
@@ -232,3 +243,32 @@ def test_switch_to_one_thread_loops_mid_run(monkeypatch):
         assert sim._serial() == switch or tdem.backend._state["threads"] == 1
         runs.append(sim.particles.numpy()["position"])
     np.testing.assert_allclose(runs[1], runs[0], rtol=0, atol=1e-9)
+
+
+def test_chunk_rule_for_the_pair_loop(monkeypatch):
+    """On several CPU threads the pair loop runs in 4 chunks per thread (n/(4T)
+    particles each, rounded up), none smaller than 1024 particles; none on one thread
+    or a GPU; TDEM_CHUNKS fixes the count (0: a slot for every pair) and a bad value
+    is named."""
+    from tdem import backend
+    from tdem.errors import InputError
+    monkeypatch.setitem(backend._state, "arch", "cpu")
+    monkeypatch.setitem(backend._state, "nthreads", 2)
+    monkeypatch.delenv("TDEM_CHUNKS", raising=False)
+    assert backend.chunk_size(47068, serial=False) == 5884      # 8 chunks
+    assert backend.chunk_size(47068, serial=True) == 0
+    assert backend.max_chunks() == 8
+    assert backend.chunk_size(5000, serial=False) == 1250      # 4 chunks
+    assert backend.chunk_size(225, serial=False) == 225        # one
+    monkeypatch.setitem(backend._state, "nthreads", 16)
+    assert backend.chunk_size(1_000_000, serial=False) == 15625 and backend.max_chunks() == 64
+    monkeypatch.setenv("TDEM_CHUNKS", "3")
+    assert backend.chunk_size(300, serial=False) == 100 and backend.max_chunks() == 3
+    monkeypatch.setenv("TDEM_CHUNKS", "0")
+    assert backend.chunk_size(300, serial=False) == 0 and backend.max_chunks() == 1
+    monkeypatch.setenv("TDEM_CHUNKS", "a few")
+    with pytest.raises(InputError, match="TDEM_CHUNKS.*'a few'"):
+        backend.chunk_size(300, serial=False)
+    monkeypatch.delenv("TDEM_CHUNKS")
+    monkeypatch.setitem(backend._state, "arch", "cuda")
+    assert backend.chunk_size(1_000_000, serial=False) == 0
