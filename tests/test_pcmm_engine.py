@@ -201,8 +201,15 @@ def _momentum(sim):
     return mv.sum(axis=0), np.abs(mv).sum()
 
 
-def test_momentum_conserved_while_elements_die_and_are_born():
+@pytest.mark.parametrize("chunks", [None, "4", "0"])
+def test_momentum_conserved_while_elements_die_and_are_born(chunks, monkeypatch):
+    """Also with the step's pair loop in 4 chunks and with a slot for every pair (the
+    GPU's path), where pairs carried by elements are skipped across chunks."""
+    if chunks is not None:
+        monkeypatch.setenv("TDEM_CHUNKS", chunks)
     sim, rad = _soft_body()
+    if chunks == "4" and not sim._serial():       # (several threads)
+        assert tdem.backend.chunk_size(sim.n_particles, False) == -(-sim.n_particles // 4)
     p0, scale = _momentum(sim)
     seen = set()
     born = died = 0
