@@ -315,6 +315,7 @@ class Runner:
         p[stepk.P_ALPHA_LOCAL] = self.local_damping
         p[stepk.P_SKIN] = self.skin
         p[stepk.P_NWALLS] = len(self._walls_host)
+        p[stepk.P_CHUNK] = backend.chunk_size(self._n, self._serial())
         for (c0, cl), span in zip(((stepk.P_PX0, stepk.P_PLX), (stepk.P_PY0, stepk.P_PLY),
                                    (stepk.P_PZ0, stepk.P_PLZ)), self._periodic):
             if span is not None:
@@ -529,8 +530,9 @@ class Runner:
         if chunk:
             self._a["simp"][stepk.P_CHUNK] = chunk
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=serial,
-                           chunk=chunk > 0, loads=bool(self._loads_on), detail=False, continuum=False,
-                           laws=self._law_set, shapes=False, dim=self.dim)[:-5]
+                           chunk=chunk > 0, loads=bool(self._loads_on), detail=False,
+                           continuum=False, laws=self._law_set, shapes=False,
+                           dim=self.dim)[:-5]
 
     def _xforce(self):
         if self._cont is not None:

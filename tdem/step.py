@@ -501,6 +501,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     sp = 0
     if ti.static(chunk):
         csz = ti.cast(simp[P_CHUNK], ti.i32)
+        if csz < 1:
+            csz = n     # (not set: one chunk, the one-thread order)
         if csz < n:
             sp = 10
     ti.loop_config(serialize=serial)
