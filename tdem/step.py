@@ -506,13 +506,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         if csz < n:
             sp = 10
     ti.loop_config(serialize=serial)
-    for cs_ in range(((n + csz - 1) // csz) << sp):
-        lo = (cs_ >> sp) * csz
+    for it in range(((n + csz - 1) // csz) << sp):
+        lo = (it >> sp) * csz
         row = 0         # the chunk's row of the walls' partial sums
         if ti.static(chunk):
-            row = cs_ >> sp
+            row = it >> sp
         end = ti.min(n, lo + csz)
-        if cs_ & ((1 << sp) - 1) != 0:
+        if it & ((1 << sp) - 1) != 0:
             end = lo
         for i in range(lo, end):
             f = vec_zero(dim)
