@@ -20,6 +20,7 @@ Prints ``PEER tdem <threads> particle_steps_per_s <value>`` like the peers' scri
     python benchmarks/pack3d.py --broad-phase sweep    # sort-and-sweep instead of the grid
     python benchmarks/pack3d.py --cubes --pour         # cubes falling: the lists rebuilt often
     python benchmarks/pack3d.py --bare                 # ... and the step written bare
+    python benchmarks/pack3d.py --threads 2 --profile  # the time of each loop of the step
 
 Every run prints how many list builds its timed steps made and their time.
 
@@ -244,10 +245,13 @@ class BuildClock:
 
 
 def measure(scale, steps, warmup, arch, threads, ellipsoids=False, cubes=False, bed=None,
-            broad_phase="grid", clock=None):
+            broad_phase="grid", clock=None, profile=False):
     sim = (build_cubes(arch, threads, scale, bed, broad_phase) if cubes else
            build(scale, arch, threads, ellipsoids, broad_phase))
     sim.run(steps=warmup)
+    if profile:
+        import taichi as ti
+        ti.profiler.clear_kernel_profiler_info()
     if clock is not None:
         clock.on = True
     t = time.perf_counter()
@@ -288,8 +292,13 @@ def main(argv=None):
     p.add_argument("--bare", action="store_true",
                    help="then the same step written bare (benchmarks/bare3d.py) on the "
                         "engine's bed, with ndarrays and with fields")
+    p.add_argument("--profile", action="store_true",
+                   help="Taichi's kernel profiler over the timed steps: the time of each "
+                        "loop of the step (its rate is then lower: each loop is timed)")
     p.add_argument("--json", default=None, help="append the results to this JSON file")
     args = p.parse_args(argv)
+    if args.profile:
+        os.environ["TDEM_PROFILE"] = "1"
     if args.scaling:
         for scale in (0.2125, 1.0, 2.125, 4.25, 10.625):
             cmd = [sys.executable, __file__, "--threads", str(args.threads), "--steps",
@@ -305,7 +314,11 @@ def main(argv=None):
         bed = "pour"
     clock = BuildClock() if (args.arch or "cpu") == "cpu" else None
     sim, rate, el = measure(args.scale, args.steps, args.warmup, args.arch, args.threads,
-                            args.ellipsoids, args.cubes, bed, args.broad_phase, clock)
+                            args.ellipsoids, args.cubes, bed, args.broad_phase, clock,
+                            args.profile)
+    if args.profile:
+        import taichi as ti
+        ti.profiler.print_kernel_profiler_info("count")
     if args.cubes:
         print(f"contacts {len(sim.contacts.numpy()['pairs'])}")
     s = sim.particles.numpy()
