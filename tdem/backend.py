@@ -144,8 +144,10 @@ CHUNKS_PER_THREAD = 4
 MIN_CHUNK = 1024
 
 
-def _chunks_asked():
-    env = os.environ.get("TDEM_CHUNKS")
+def _env_count(name):
+    """The whole number >= 0 in environment variable ``name``, None where it is unset
+    or empty; anything else is refused, naming the variable."""
+    env = os.environ.get(name)
     if not env:
         return None
     try:
@@ -153,8 +155,12 @@ def _chunks_asked():
     except ValueError:
         k = -1
     if k < 0:
-        raise InputError(f"TDEM_CHUNKS must be a whole number >= 0, got {env!r}")
+        raise InputError(f"{name} must be a whole number >= 0, got {env!r}")
     return k
+
+
+def _chunks_asked():
+    return _env_count("TDEM_CHUNKS")
 
 
 def chunks_wanted():
@@ -175,10 +181,11 @@ def chunk_size(n, serial):
     """Particles per chunk of the step's pair loop for a model of n particles: 0 on
     one thread (``serial``) and on a GPU (every pair through its slot), else
     n / :func:`chunks_wanted`, rounded up, and at least MIN_CHUNK unless
-    ``$TDEM_CHUNKS`` asks (one chunk: the one-thread order on one thread). The result depends on the chunks (the
-    order in which pairs across them are summed), not on which thread runs which: a
-    run repeats itself bit for bit with the same chunks, and runs with other chunks
-    agree to round-off. ``$TDEM_CHUNKS=K`` fixes the count whatever the threads."""
+    ``$TDEM_CHUNKS`` asks (one chunk: the one-thread order on one thread). The result
+    depends on the chunks (the order in which pairs across them are summed), not on
+    which thread runs which: a run repeats itself bit for bit with the same chunks,
+    and runs with other chunks agree to round-off. ``$TDEM_CHUNKS=K`` fixes the
+    count whatever the threads."""
     if serial or _state["arch"] != "cpu":
         return 0
     k = chunks_wanted()
@@ -195,14 +202,8 @@ def serial_below(elements=False):
     the pool), so one thread is faster below n = D/(c·(1 − 1/T)): the sizes measured
     on 2 threads times 0.5/(1 − 1/T) (0.53 on 16 threads). ``$TDEM_SERIAL_BELOW``
     sets the size for every thread count and model (0: never)."""
-    env = os.environ.get("TDEM_SERIAL_BELOW")
-    if env:
-        try:
-            below = int(env)
-        except ValueError:
-            below = -1
-        if below < 0:
-            raise InputError(f"TDEM_SERIAL_BELOW must be a whole number >= 0, got {env!r}")
+    below = _env_count("TDEM_SERIAL_BELOW")
+    if below is not None:
         return below
     base = SERIAL_BELOW_ELEMENTS if elements else SERIAL_BELOW_DEM
     t = max(int(_state["nthreads"] or 2), 2)

@@ -315,7 +315,7 @@ class Runner:
         p[stepk.P_ALPHA_LOCAL] = self.local_damping
         p[stepk.P_SKIN] = self.skin
         p[stepk.P_NWALLS] = len(self._walls_host)
-        p[stepk.P_CHUNK] = backend.chunk_size(self._n, self._serial())
+        p[stepk.P_CHUNK] = self._chunk()
         for (c0, cl), span in zip(((stepk.P_PX0, stepk.P_PLX), (stepk.P_PY0, stepk.P_PLY),
                                    (stepk.P_PZ0, stepk.P_PLZ)), self._periodic):
             if span is not None:
@@ -525,14 +525,18 @@ class Runner:
     def _step_args(self):
         # the arrays by name; _one_step appends the last five (detail, continuum, laws,
         # shapes, dim)
-        serial = self._serial()
-        chunk = backend.chunk_size(self._n, serial)
-        if chunk:
-            self._a["simp"][stepk.P_CHUNK] = chunk
-        return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=serial,
-                           chunk=chunk > 0, loads=bool(self._loads_on), detail=False,
+        # (the chunk size itself goes up with the engine's parameters, _upload_params)
+        return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
+                           chunk=self._chunk() > 0, loads=bool(self._loads_on), detail=False,
                            continuum=False, laws=self._law_set, shapes=False,
                            dim=self.dim)[:-5]
+
+    def _chunk(self):
+        """Particles per chunk of the step's pair loop (:func:`tdem.backend.chunk_size`),
+        0: none; never more chunks than the walls' partial sums have rows."""
+        chunk = backend.chunk_size(self._n, self._serial())
+        rows = self._a["wpart"].shape[0] if "wpart" in self._a else 1
+        return max(chunk, -(-self._n // rows)) if chunk else 0
 
     def _xforce(self):
         if self._cont is not None:

@@ -16,8 +16,9 @@ snapshot); ``scratch`` arrays are rebuilt whenever needed (neither).
 
 Owners and their shapes: ``particle`` (n,), ``slot`` (n, cap) the half neighbour
 list, ``wall_slot`` (n, capw) a particle's candidate walls, ``wall`` (walls,),
-``wall_part`` (chunks, walls) per chunk of the step's pair loop, and fixed-size tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's
-or a wall contact's history vector (as wide as the registered contact laws need,
+``wall_part`` (chunks, walls) per chunk of the step's pair loop, and fixed-size
+tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's or a wall
+contact's history vector (as wide as the registered contact laws need,
 :mod:`physics.contact_law`).
 
 :mod:`tdem.continuum` keeps the PCMM, block and coupling arrays in the same way
