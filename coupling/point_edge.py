@@ -46,8 +46,10 @@ restart their springs from zero (the stack would ratchet down at each jiggle).
 Broad phase: every step the boundary edges of the coupled blocks are binned into a
 uniform grid over their bounding box (:func:`bin_edges`; an edge goes into every cell
 its bounding box, widened by the largest reach of a point — R of a particle, the
-vertex depth of a vertex — overlaps), and each point tests only the edges of its own
-cell. A point outside the grid touches no edge. The grid has at most ``GRID`` cells
+deepest crossing ``VERTEX_DEPTH`` × A of a vertex, plus ``VERTEX_END`` × its length
+for vertices — overlaps), and each point tests only the edges of its own cell. Each
+block's edges are listed once, however many couples reach them; a couple's rows
+test only the edges of its own block. A point outside the grid touches no edge. The grid has at most ``GRID`` cells
 a side (cell side ≥ twice the reach), the cell lists are sorted by edge index, so
 that the result does not depend on the thread count.
 
@@ -143,13 +145,6 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
         kn = claw[c, L_KN]
         ks = claw[c, L_KS]
         tanf = claw[c, L_TAN]
-        # the slots of the previous step, read before they are rewritten
-        old_e = ti.Vector([sedge[q, k] for k in ti.static(range(SLOTS))])
-        old_f = ti.Matrix([[sforce[q, k][0], sforce[q, k][1]] for k in ti.static(range(SLOTS))])
-        old_b = ti.Vector([sbroken[q, k] for k in ti.static(range(SLOTS))])
-        cnt = 0
-        ftot = ti.Vector([0.0, 0.0])
-        best = -1
         # the cell of the point in the broad-phase grid (−1: outside, no edge near)
         cell = -1
         h = gpar[G_H]
@@ -161,6 +156,15 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
         ncand = 0
         if cell >= 0:
             ncand = ti.min(gcnt[cell], gcap)
+        if ncand == 0 and sedge[q, 0] < 0:
+            continue        # no edge near, no contact to forget (slots fill from 0)
+        # the slots of the previous step, read before they are rewritten
+        old_e = ti.Vector([sedge[q, k] for k in ti.static(range(SLOTS))])
+        old_f = ti.Matrix([[sforce[q, k][0], sforce[q, k][1]] for k in ti.static(range(SLOTS))])
+        old_b = ti.Vector([sbroken[q, k] for k in ti.static(range(SLOTS))])
+        cnt = 0
+        ftot = ti.Vector([0.0, 0.0])
+        best = -1
         e_lo = crange[c, 0]
         e_hi = crange[c, 1]
         if R < 0.0:
@@ -280,12 +284,13 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
 @cached
 @ti.kernel
 def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64,
-              hmin: ti.f64, gpar: ti.types.ndarray(), gcnt: ti.types.ndarray(),
+              hmin: ti.f64, end: ti.f64, gpar: ti.types.ndarray(), gcnt: ti.types.ndarray(),
               gedge: ti.types.ndarray(), need: ti.types.ndarray()):
     """Broad phase (module docstring): the grid over the edges' bounding box widened
-    by ``reach`` (cell side max(hmin, extent/GRID)), and the edges of every cell,
-    sorted by index (gcnt[c] may exceed gedge's capacity: need[0] gets the largest
-    count, the caller grows the lists and bins again)."""
+    by ``reach`` (cell side max(hmin, extent/GRID)), and the edges of every cell (an
+    edge of length L widened by ``reach`` + ``end`` × L: the part past its ends where
+    a vertex still meets it), sorted by index (gcnt[c] may exceed gedge's capacity:
+    need[0] gets the largest count, the caller grows the lists and bins again)."""
     ne = edges.shape[0]
     ti.loop_config(serialize=True)
     for _ in range(1):
@@ -295,37 +300,37 @@ def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64
         gpar[G_Y1] = -1e300
         need[0] = 0
     for e in range(ne):
-        for k in ti.static(range(2)):
-            x = npos[edges[e, k]]
-            ti.atomic_min(gpar[G_X0], x[0])
-            ti.atomic_min(gpar[G_Y0], x[1])
-            ti.atomic_max(gpar[G_X1], x[0])
-            ti.atomic_max(gpar[G_Y1], x[1])
+        xa = npos[edges[e, 0]]
+        xb = npos[edges[e, 1]]
+        w = reach + end * (xb - xa).norm()
+        ti.atomic_min(gpar[G_X0], ti.min(xa[0], xb[0]) - w)
+        ti.atomic_min(gpar[G_Y0], ti.min(xa[1], xb[1]) - w)
+        ti.atomic_max(gpar[G_X1], ti.max(xa[0], xb[0]) + w)
+        ti.atomic_max(gpar[G_Y1], ti.max(xa[1], xb[1]) + w)
     ti.loop_config(serialize=True)
     for _ in range(1):
-        x0 = gpar[G_X0] - reach
-        y0 = gpar[G_Y0] - reach
-        ext = ti.max(gpar[G_X1] + reach - x0, gpar[G_Y1] + reach - y0)
+        x0 = gpar[G_X0]
+        y0 = gpar[G_Y0]
+        ext = ti.max(gpar[G_X1] - x0, gpar[G_Y1] - y0)
         h = ti.max(hmin, ext / GRID) * (1.0 + 1e-9)
-        gpar[G_X0] = x0
-        gpar[G_Y0] = y0
         gpar[G_H] = h
-        gpar[G_NX] = ti.cast(ti.min(ti.floor((gpar[G_X1] + reach - x0) / h) + 1, GRID), ti.f64)
-        gpar[G_NY] = ti.cast(ti.min(ti.floor((gpar[G_Y1] + reach - y0) / h) + 1, GRID), ti.f64)
+        gpar[G_NX] = ti.cast(ti.min(ti.floor((gpar[G_X1] - x0) / h) + 1, GRID), ti.f64)
+        gpar[G_NY] = ti.cast(ti.min(ti.floor((gpar[G_Y1] - y0) / h) + 1, GRID), ti.f64)
     for c in range(gcnt.shape[0]):
         gcnt[c] = 0
     cap = gedge.shape[1]
     for e in range(ne):
         xa = npos[edges[e, 0]]
         xb = npos[edges[e, 1]]
+        w = reach + end * (xb - xa).norm()
         h = gpar[G_H]
         nx = ti.cast(gpar[G_NX], ti.i32)
         ny = ti.cast(gpar[G_NY], ti.i32)
-        i0 = ti.max(ti.cast(ti.floor((ti.min(xa[0], xb[0]) - reach - gpar[G_X0]) / h), ti.i32), 0)
-        i1 = ti.min(ti.cast(ti.floor((ti.max(xa[0], xb[0]) + reach - gpar[G_X0]) / h), ti.i32),
+        i0 = ti.max(ti.cast(ti.floor((ti.min(xa[0], xb[0]) - w - gpar[G_X0]) / h), ti.i32), 0)
+        i1 = ti.min(ti.cast(ti.floor((ti.max(xa[0], xb[0]) + w - gpar[G_X0]) / h), ti.i32),
                     nx - 1)
-        j0 = ti.max(ti.cast(ti.floor((ti.min(xa[1], xb[1]) - reach - gpar[G_Y0]) / h), ti.i32), 0)
-        j1 = ti.min(ti.cast(ti.floor((ti.max(xa[1], xb[1]) + reach - gpar[G_Y0]) / h), ti.i32),
+        j0 = ti.max(ti.cast(ti.floor((ti.min(xa[1], xb[1]) - w - gpar[G_Y0]) / h), ti.i32), 0)
+        j1 = ti.min(ti.cast(ti.floor((ti.max(xa[1], xb[1]) + w - gpar[G_Y0]) / h), ti.i32),
                     ny - 1)
         for j in range(j0, j1 + 1):
             for i in range(i0, i1 + 1):

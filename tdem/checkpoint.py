@@ -41,7 +41,8 @@ from .errors import InputError
 from .step import T_LAW, W_LAW, wall_width
 
 FORMAT = "tdem-checkpoint"
-VERSION = 3     # 2: particle shapes and angles; two more history columns; 3: work account
+VERSION = 4     # 2: particle shapes and angles; two more history columns; 3: work account;
+                # 4: each block's boundary edges listed once for its point-edge couples
 _FIX_NAMES = ("vx", "vy", "omega")
 _FIX_NAMES_3D = ("vx", "vy", "vz", "omega")
 _HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle", "omega")
@@ -594,6 +595,8 @@ def load(path, arch=None):
             if k == "pjwl" and v.ndim == 2 and v.shape[1] == 5:
                 # files written before the pending volume change (column 5) was kept
                 v = np.concatenate([v, np.zeros((len(v), 1))], axis=1)
+            if k in ("psedge", "vsedge") and raw["version"] < 4:
+                v = sim._cont.edges_from_version_3(k[0], v)
             if tuple(arr.shape) != v.shape[:len(arr.shape)]:
                 raise InputError(f"path: checkpoint {str(path)!r} is damaged: "
                                  f"'/continuum/{k}' has shape {v.shape}, expected "

@@ -333,6 +333,12 @@ class Continuum:
         self.nq = {"p": 0, "v": 0}
         self.reach = {"p": 0.0, "v": 0.0}
         rows = {"p": ([], [], [], [], [], [], []), "v": ([], [], [], [], [], [], [])}
+        # each block's boundary edges are listed once per kind, whatever the number of
+        # couples that reach them (the broad phase bins each edge once); ``_old_edges``
+        # maps the layout of checkpoints before version 4 (the edges copied for every
+        # couple) onto this one
+        listed = {"p": {}, "v": {}}
+        self._old_edges = {"p": [], "v": []}
         for ids, a, block, law, kn, ks in couples:
             if a is None:           # particles ids against block
                 pairs = [("p", np.asarray(ids, np.int64), None, block)]
@@ -342,7 +348,12 @@ class Continuum:
                 parts, cpl, ranges, edges, laws, rad, nbr = rows[kind]
                 k = len(laws)
                 be = _boundary_edges(dst.triangles) + dst._offset
-                e0 = sum(len(x) for x in edges)
+                if id(dst) not in listed[kind]:
+                    e0 = sum(len(x) for x in edges)
+                    listed[kind][id(dst)] = e0
+                    edges.append(be)
+                e0 = listed[kind][id(dst)]
+                self._old_edges[kind].append(np.arange(e0, e0 + len(be)))
                 if kind == "p":
                     pts = pid
                     r = self._radius_of(pid)
@@ -365,7 +376,6 @@ class Continuum:
                 parts.append(np.asarray(pts, np.int32))
                 cpl.append(np.full(len(pts), k, np.int32))
                 ranges.append((e0, e0 + len(be)))
-                edges.append(be)
                 laws.append(law.row(kn, ks))
                 rad.append(np.asarray(r, float))
                 nbr.append(nb.astype(np.int32))
@@ -395,7 +405,10 @@ class Continuum:
             a[kind + "gedge"] = ti.ndarray(ti.i32, (pe.GRID * pe.GRID,
                                                     min(max(ne, 1), 256)))
             a[kind + "gneed"] = ti.ndarray(ti.i32, (1,))
-            self.reach[kind] = float(np.max(np.abs(np.concatenate(rad)))) if n else 0.0
+            # how far from an edge a point can touch it: R of a particle, the deepest
+            # crossing of a vertex (VERTEX_DEPTH × its tributary length)
+            far = float(np.max(np.abs(np.concatenate(rad)))) if n else 0.0
+            self.reach[kind] = far if kind == "p" else pe.VERTEX_DEPTH * far
             if n:
                 a[kind + "part"].from_numpy(np.concatenate(parts))
                 a[kind + "cpl"].from_numpy(np.concatenate(cpl))
@@ -404,6 +417,16 @@ class Continuum:
                 a[kind + "edges"].from_numpy(np.concatenate(edges).astype(np.int32))
                 a[kind + "nbr"].from_numpy(np.concatenate(nbr))
                 a[kind + "law"].from_numpy(np.array(laws, float))
+
+    def edges_from_version_3(self, kind, sedge):
+        """Contact slots' edge indices of a checkpoint before version 4 (the edges
+        copied for every couple, in couple order) in this layout."""
+        old = self._old_edges[kind]
+        table = np.concatenate(old) if old else np.zeros(0, np.int64)
+        sedge = np.asarray(sedge)
+        out = np.where(sedge >= 0, table[np.clip(sedge, 0, max(len(table) - 1, 0))]
+                       if len(table) else -1, -1)
+        return out.astype(sedge.dtype)
 
     def _radius_of(self, ids):
         return self.a["rad"].to_numpy()[ids] if self.n else np.zeros(len(ids))
@@ -612,7 +635,8 @@ class Continuum:
         a = self.a
         r = self.reach[kind]
         while True:
-            pe.bin_edges(a["npos"], a[kind + "edges"], r, 2.0 * r, a[kind + "gpar"],
+            pe.bin_edges(a["npos"], a[kind + "edges"], r, 2.0 * r,
+                         pe.VERTEX_END if kind == "v" else 0.0, a[kind + "gpar"],
                          a[kind + "gcnt"], a[kind + "gedge"], a[kind + "gneed"])
             cap = a[kind + "gedge"].shape[1]
             if cap >= a[kind + "edges"].shape[0]:

@@ -363,3 +363,49 @@ def test_stacked_rigid_blocks_pushed_sideways_stay_on_each_other():
         assert np.all(sink < 42.0 * m * G / kn), (sim.time, sink)
         assert np.abs(v).max() < V, (sim.time, v)
         assert 0.5 * m * (v ** 2).sum() < 0.5 * m * V ** 2 + m * G * sink.sum(), sim.time
+
+
+def test_checkpoint_before_version_4_restores_its_vertex_edge_contacts(tmp_path):
+    """Before version 4 a checkpoint's contact slots named the edges of a copy of
+    each block's boundary per couple; such a file (made here from a version-4 one,
+    the slots turned into that layout) loads with the same contacts and continues
+    bit for bit as the version-4 file does."""
+    import h5py
+    sim = tdem.Simulation(gravity=(0.0, -G), dt=9.4e-5, local_damping=0.0, progress=False)
+    concrete = tdem.Elastic(density=2400.0, young=30e9, poisson=0.2)
+    fv, ft = tdem.mesh.rectangle(1.0, 0.1, 1, 1, origin=(-0.5, -0.1))
+    floor = sim.add_block(fv, ft, material=concrete, rigid=True)
+    floor.fix(np.arange(len(fv)), vx=0.0, vy=0.0)
+    blocks = [sim.add_block(np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]])
+                            + [0.02 * r, 0.1 * r], np.array([[0, 1, 2], [0, 2, 3]]),
+                            material=concrete, rigid=True) for r in range(4)]
+    law = tdem.PointEdge(kn=3e8, ks=1e8, friction_angle=25.0)
+    for k, b in enumerate(blocks):
+        sim.couple(b, floor, law)
+        for o in blocks[k + 1:]:
+            sim.couple(b, o, law)
+    sim.run(steps=200)
+    sim.save(tmp_path / "v4.h5")
+    a = sim._cont.a
+    new = a["vsedge"].to_numpy()
+    cpl = a["vcpl"].to_numpy()
+    per = sim._cont._old_edges["v"]
+    start = np.concatenate([[0], np.cumsum([len(e) for e in per])])
+    old = new.copy()
+    for q, k in zip(*np.nonzero(new >= 0)):
+        c = cpl[q]
+        old[q, k] = start[c] + int(np.flatnonzero(per[c] == new[q, k])[0])
+    assert np.any(old != new) and np.count_nonzero(new >= 0) >= 4
+    import shutil
+    shutil.copy(tmp_path / "v4.h5", tmp_path / "v3.h5")
+    with h5py.File(tmp_path / "v3.h5", "r+") as f:
+        f["continuum/vsedge"][...] = old
+        f.attrs["version"] = 3
+    one = tdem.Simulation.load(tmp_path / "v4.h5")
+    two = tdem.Simulation.load(tmp_path / "v3.h5")
+    assert np.array_equal(two._cont.a["vsedge"].to_numpy(), new)
+    one.run(steps=200)
+    two.run(steps=200)
+    for b1, b2 in zip(one.blocks, two.blocks):
+        assert np.array_equal(b1.nodes()["position"], b2.nodes()["position"])
+        assert np.array_equal(b1.nodes()["force"], b2.nodes()["force"])
