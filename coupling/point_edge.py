@@ -124,7 +124,7 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
                sforce: ti.types.ndarray(), sbroken: ti.types.ndarray(),
                xforce: ti.types.ndarray(), nforce: ti.types.ndarray(),
                gpar: ti.types.ndarray(), gcnt: ti.types.ndarray(),
-               gedge: ti.types.ndarray(), dt: ti.f64):
+               gedge: ti.types.ndarray(), dt: ti.f64, serial: ti.template()):
     """Contacts of every coupled row q (point cpart[q] of ``pos``/``vel`` with the
     edges crange[ccpl[q]] of a block): forces added to ``xforce`` (the points) and
     ``nforce`` (the edges' nodes). Slots: sedge (edge or −1), sforce (F_n, F_s),
@@ -136,6 +136,7 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
     it: cnbr[q] are its two neighbours on its block's boundary, in ``pos``).
     gpar, gcnt, gedge: the broad-phase grid of :func:`bin_edges`."""
     gcap = gedge.shape[1]
+    ti.loop_config(serialize=serial)
     for q in range(cpart.shape[0]):
         p = cpart[q]
         c = ccpl[q]
@@ -285,7 +286,7 @@ def point_edge(pos: ti.types.ndarray(), vel: ti.types.ndarray(), crad: ti.types.
 @ti.kernel
 def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64,
               hmin: ti.f64, end: ti.f64, gpar: ti.types.ndarray(), gcnt: ti.types.ndarray(),
-              gedge: ti.types.ndarray(), need: ti.types.ndarray()):
+              gedge: ti.types.ndarray(), need: ti.types.ndarray(), serial: ti.template()):
     """Broad phase (module docstring): the grid over the edges' bounding box widened
     by ``reach`` (cell side max(hmin, extent/GRID)), and the edges of every cell (an
     edge of length L widened by ``reach`` + ``end`` × L: the part past its ends where
@@ -299,6 +300,7 @@ def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64
         gpar[G_X1] = -1e300
         gpar[G_Y1] = -1e300
         need[0] = 0
+    ti.loop_config(serialize=serial)
     for e in range(ne):
         xa = npos[edges[e, 0]]
         xb = npos[edges[e, 1]]
@@ -316,9 +318,11 @@ def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64
         gpar[G_H] = h
         gpar[G_NX] = ti.cast(ti.min(ti.floor((gpar[G_X1] - x0) / h) + 1, GRID), ti.f64)
         gpar[G_NY] = ti.cast(ti.min(ti.floor((gpar[G_Y1] - y0) / h) + 1, GRID), ti.f64)
+    ti.loop_config(serialize=serial)
     for c in range(gcnt.shape[0]):
         gcnt[c] = 0
     cap = gedge.shape[1]
+    ti.loop_config(serialize=serial)
     for e in range(ne):
         xa = npos[edges[e, 0]]
         xb = npos[edges[e, 1]]
@@ -338,6 +342,7 @@ def bin_edges(npos: ti.types.ndarray(), edges: ti.types.ndarray(), reach: ti.f64
                 k = ti.atomic_add(gcnt[c], 1)
                 if k < cap:
                     gedge[c, k] = e
+    ti.loop_config(serialize=serial)
     for c in range(gcnt.shape[0]):
         m = gcnt[c]
         if m > cap:

@@ -607,17 +607,17 @@ class Continuum:
         if self.nq["p"]:
             if not self.has_pcmm:
                 a["xforce"].fill(0.0)
-            self._bin_edges("p")
+            self._bin_edges("p", sim._serial())
             pe.point_edge(e["pos"], e["vel"], a["prad"], a["npos"], a["nvel"], a["ppart"],
                           a["pcpl"], a["prange"], a["pedges"], a["pnbr"], a["plaw"], a["psedge"],
                           a["psforce"], a["psbroken"], a["xforce"], a["nforce"],
-                          a["pgpar"], a["pgcnt"], a["pgedge"], float(dt))
+                          a["pgpar"], a["pgcnt"], a["pgedge"], float(dt), sim._serial())
         if self.nq["v"]:
-            self._bin_edges("v")
+            self._bin_edges("v", sim._serial())
             pe.point_edge(a["npos"], a["nvel"], a["vrad"], a["npos"], a["nvel"], a["vpart"],
                           a["vcpl"], a["vrange"], a["vedges"], a["vnbr"], a["vlaw"], a["vsedge"],
                           a["vsforce"], a["vsbroken"], a["nforce"], a["nforce"],
-                          a["vgpar"], a["vgcnt"], a["vgedge"], float(dt))
+                          a["vgpar"], a["vgcnt"], a["vgedge"], float(dt), sim._serial())
 
     def viscous_boundaries(self, sim):
         """Stage: non-reflecting (viscous) boundary tractions into the same forces."""
@@ -629,15 +629,15 @@ class Continuum:
                     a["xforce"].fill(0.0)
                 viscous_boundary(vel, force, a["nr" + kind + "ids"], a["nr" + kind + "coef"])
 
-    def _bin_edges(self, kind):
+    def _bin_edges(self, kind, serial):
         """The broad-phase grid of the edges of ``kind``'s couples, its cell lists
-        grown until every cell's edges fit."""
+        grown until every cell's edges fit (``serial``: the loops on one thread)."""
         a = self.a
         r = self.reach[kind]
         while True:
             pe.bin_edges(a["npos"], a[kind + "edges"], r, 2.0 * r,
                          pe.VERTEX_END if kind == "v" else 0.0, a[kind + "gpar"],
-                         a[kind + "gcnt"], a[kind + "gedge"], a[kind + "gneed"])
+                         a[kind + "gcnt"], a[kind + "gedge"], a[kind + "gneed"], serial)
             cap = a[kind + "gedge"].shape[1]
             if cap >= a[kind + "edges"].shape[0]:
                 return
