@@ -666,16 +666,22 @@ def say(text):
     print(text, flush=True)
 
 
-def gather_in_order(futures, name, line):
+def gather_in_order(futures, name, line, each=None, offset=0, total=None):
     """The results of Dask ``futures`` in their order, printing "``name``: count
-    ``line(result)``" as each one ends (a sweep's progress)."""
+    ``line(result)``" as each one ends (a sweep's progress; the count starts after
+    ``offset`` results found before, out of ``total``). ``each(k, result)`` is
+    called as result k ends (e.g. to keep it on disk)."""
     from distributed import as_completed
     index = {f.key: k for k, f in enumerate(futures)}
     results = [None] * len(futures)
+    total = len(futures) + offset if total is None else total
     for done, f in enumerate(as_completed(futures), 1):
         r = f.result()
-        results[index[f.key]] = r
-        say(f"{name}: {done}/{len(futures)} {line(r)}")
+        k = index[f.key]
+        results[k] = r
+        if each is not None:
+            each(k, r)
+        say(f"{name}: {done + offset}/{total} {line(r)}")
     return results
 
 

@@ -74,8 +74,10 @@ returns its checkpoint; one task per test compresses a copy of it. paper: delta 
 0, 0.1 ... 1.6 for Models 1 and 2 at 100, 200 and 400 kPa (99 tests, 0.1 /s at
 200 kPa to 20 %: several hours on 2 cores); quick: delta = 0, 0.4, 0.8, 1.6 for
 Model 1 and delta = 0.4 for Model 2 at the three stresses (15 tests, 0.5 /s at
-200 kPa to 10 %, about 6 minutes). Results are gathered into ``sweep.h5`` (a group
-per test) and plotted: ``fig12_envelopes.png`` (peak and residual envelopes of the
+200 kPa to 10 %, about 6 minutes). Each test's result is kept in ``OUT/tests/`` as
+it ends; the same command started again after an interruption reads those back and
+runs only the rest. Results are gathered into ``sweep.h5`` (a group per test) and
+plotted: ``fig12_envelopes.png`` (peak and residual envelopes of the
 three Fig. 12 materials with the paper's slopes) and ``fig13_phi_delta.png`` (phi
 against delta, mean and range over the confining stresses, the paper's values
 beside).
@@ -301,26 +303,62 @@ def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None):
             for s in confining for (m, d) in materials]
 
 
-def run_sweep(tasks, scheduler=None, workers=2):
+def result_file(folder, task):
+    """Where :func:`run_sweep` keeps the result of ``task`` in ``folder``."""
+    from pathlib import Path
+    model, delta = check_material(task["model"], task["delta"])
+    return Path(folder) / (f"sigma{task['confining'] / 1e3:g}kPa_{material_name(model, delta)}"
+                           f"_rate{task['strain_rate']:.6g}_strain{task['axial_strain']:g}"
+                           f"_n{task['n']}_seed{task.get('seed', SEED)}.h5")
+
+
+def run_sweep(tasks, scheduler=None, workers=2, keep=None):
     """Run ``tasks`` on Dask and return their results in order.
 
     One task per specimen (:func:`prepare_task`, one per :func:`specimen_key`), then
     one per test (:func:`shear_task`), which receives its specimen's checkpoint from
     the scheduler, so workers need no shared disk. ``scheduler``: address of an
     existing cluster; None starts a ``distributed.LocalCluster`` of ``workers``
-    processes with one thread each. Needs Dask (``pip install "tdem[sweep]"``)."""
+    processes with one thread each. Needs Dask (``pip install "tdem[sweep]"``).
+
+    ``keep``: a folder where each test's result is written as it ends
+    (:func:`result_file`); the tests already there are read back instead of run,
+    so an interrupted sweep started again goes on where it stopped."""
+    results = [None] * len(tasks)
+    if keep is not None:
+        from pathlib import Path
+        Path(keep).mkdir(parents=True, exist_ok=True)
+        for k, t in enumerate(tasks):
+            path = result_file(keep, t)
+            if path.exists():
+                results[k] = load_results(path)[0]
+    todo = [k for k, r in enumerate(results) if r is None]
+    if keep is not None and len(todo) < len(tasks):
+        common.say(f"biaxial sweep: {len(tasks) - len(todo)} of {len(tasks)} tests read back "
+                   f"from {keep}")
+    if not todo:
+        return results
+
+    def kept(j, r):
+        if keep is not None:
+            save_results(result_file(keep, tasks[todo[j]]), [r])
+
     with common.dask_client(scheduler, workers) as client:
         specimens = {}
-        for t in tasks:
-            key = specimen_key(t)
+        for k in todo:
+            key = specimen_key(tasks[k])
             if key not in specimens:
-                specimens[key] = client.submit(prepare_task, t, pure=False)
-        futures = [client.submit(shear_task, t, specimens[specimen_key(t)], pure=False)
-                   for t in tasks]
-        return common.gather_in_order(futures, "biaxial sweep", lambda r: (
+                specimens[key] = client.submit(prepare_task, tasks[k], pure=False)
+        futures = [client.submit(shear_task, tasks[k], specimens[specimen_key(tasks[k])],
+                                 pure=False) for k in todo]
+        done = common.gather_in_order(futures, "biaxial sweep", lambda r: (
             f"{r['name']} at {r['task']['confining'] / 1e3:g} kPa: peak phi "
             f"{r['phi']['phi_peak']:.1f}°, residual {r['phi']['phi_residual']:.1f}° "
-            f"({r['wall_s']:.0f} s)"))
+            f"({r['wall_s']:.0f} s)"), each=kept, offset=len(tasks) - len(todo),
+            total=len(tasks))
+    for k, r in zip(todo, done):
+        results[k] = r
+    return results
 
 
 def run_serial(tasks):
@@ -377,6 +415,7 @@ def save_results(path, results, extra=None):
                     g.attrs[k] = float(v)
             for k, v in r["phi"].items():
                 g.attrs[k] = float(v)
+            g.attrs["phi"] = json.dumps(common._plain(r["phi"]))
             g.attrs["task"] = json.dumps(common._plain(r["task"]))
             g.attrs["before"] = json.dumps(common._plain(r["before"]))
             g.attrs["sigma_h_hold"] = float(r["hold"])
@@ -384,6 +423,30 @@ def save_results(path, results, extra=None):
         for k, v in (extra or {}).items():
             f.attrs[k] = json.dumps(common._plain(v))
     return path
+
+
+def load_results(path):
+    """The tests of a file of :func:`save_results`, as the dicts it was given (the
+    curves, ``phi``, ``task``, ``before``, ``hold``, ``wall_s`` and ``name``)."""
+    import json
+
+    import h5py
+    out = []
+    with h5py.File(path, "r") as f:
+        for sk in f:
+            if not isinstance(f[sk], h5py.Group):
+                continue
+            for name, g in f[sk].items():
+                curves = {k: np.asarray(d) for k, d in g.items()}
+                for k in ("sigma_h_target", "strain_rate"):
+                    if k in g.attrs:
+                        curves[k] = float(g.attrs[k])
+                out.append({"task": json.loads(g.attrs["task"]), "name": name,
+                            "curves": curves, "phi": json.loads(g.attrs["phi"]),
+                            "before": json.loads(g.attrs["before"]),
+                            "hold": float(g.attrs["sigma_h_hold"]),
+                            "wall_s": float(g.attrs["wall_s"])})
+    return out
 
 
 # ------------------------------------------------------------------ plots
@@ -607,7 +670,8 @@ def _main_sweep(args, out, cfg, clock):
     print(f"biaxial sweep ({args.preset}"
           f"{', all deltas' if args.all_deltas else ''}): {len(tasks)} tasks on "
           f"{args.scheduler or f'a local cluster of {args.workers} workers'}", flush=True)
-    results = run_sweep(tasks, scheduler=args.scheduler, workers=args.workers)
+    results = run_sweep(tasks, scheduler=args.scheduler, workers=args.workers,
+                        keep=out / "tests")
     env = envelopes(results)
     save_results(out / "sweep.h5", results, extra={"envelopes": env})
     plot_fig12(env, out / "fig12_envelopes.png")

@@ -204,3 +204,33 @@ def test_model2_between_none_and_model1(paper_runs):
     none, m1, m2 = mean(0, 0.0), mean(1, 0.4), mean(2, 0.4)
     print(f"mean peak phi: none {none:.2f}, Model 2 {m2:.2f}, Model 1 {m1:.2f}")
     assert none < m2 < m1
+
+
+def test_sweep_keeps_each_test_and_goes_on_after_an_interruption(tmp_path):
+    """Each test's result is written as it ends; started again, the sweep reads the
+    tests it finds (here: one marked in its file, so that reading it back is seen)
+    and runs the others, with the same numbers as a run without interruption."""
+    pytest.importorskip("distributed", reason='Dask is an extra: pip install "tdem[sweep]"')
+    tasks = biaxial.sweep_tasks(dict(TINY, materials=[(0, 0.0), (1, 0.4)]),
+                                confining=(SIGMA,))
+    keep = tmp_path / "tests"
+    first = biaxial.run_sweep(tasks, workers=2, keep=keep)
+    files = [biaxial.result_file(keep, t) for t in tasks]
+    assert all(f.exists() for f in files)
+    back = [biaxial.load_results(f)[0] for f in files]
+    for a, b in zip(first, back):
+        assert a["task"] == b["task"] and a["name"] == b["name"] and a["phi"] == b["phi"]
+        assert a["before"] == b["before"] and a["hold"] == b["hold"]
+        for k, v in a["curves"].items():
+            np.testing.assert_array_equal(np.asarray(v), np.asarray(b["curves"][k]))
+    # the interruption: the second test's file lost, the first one's marked
+    files[1].unlink()
+    import h5py
+    with h5py.File(files[0], "r+") as f:
+        g = f[f"sigma{SIGMA / 1e3:g}kPa/{first[0]['name']}"]
+        g.attrs["wall_s"] = -1.0
+    again = biaxial.run_sweep(tasks, workers=2, keep=keep)
+    assert again[0]["wall_s"] == -1.0                  # read back, not run again
+    assert again[1]["wall_s"] > 0.0 and files[1].exists()
+    assert again[1]["phi"] == first[1]["phi"]          # run again: the same numbers
+    np.testing.assert_array_equal(again[1]["curves"]["sigma_v"], first[1]["curves"]["sigma_v"])
