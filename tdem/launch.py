@@ -34,7 +34,7 @@ from taichi.lang._ndarray import Ndarray
 from taichi.types import ndarray_type, primitive_types
 from taichi.types.annotations import template
 
-MAX_ENTRIES = 8            # argument sets remembered per kernel
+MAX_ENTRIES = 64           # argument sets remembered per kernel (the snapshot copy: one per array)
 _generation = [0]          # bumped whenever Taichi is (re-)initialised
 
 
@@ -172,6 +172,27 @@ class Cached:
             slot += 1
         e.refs, e.scalars = tuple(refs), tuple(scalars)
         return e
+
+
+_CTYPES = {ti.i32: "c_int32", ti.i64: "c_int64", ti.f32: "c_float", ti.f64: "c_double"}
+
+
+def host_view(arr):
+    """A numpy array over the memory of the CPU ``ti.ndarray`` ``arr`` of scalars
+    (no copy; valid while ``arr`` lives): reading it costs what reading numpy does,
+    against some 10 µs for ``arr[i]``. Kernels on the CPU have finished when their
+    call returns, so the view reads what they wrote. None for other arrays."""
+    import ctypes
+
+    import numpy as np
+    name = _CTYPES.get(arr.dtype)
+    if name is None or impl.current_cfg().arch not in (ti.x64, ti.arm64) or \
+            int(arr.arr.element_size()) != ctypes.sizeof(getattr(ctypes, name)):
+        return None
+    n = int(arr.arr.nelement())
+    ptr = int(impl.get_runtime().prog.get_ndarray_data_ptr_as_int(arr.arr))
+    view = np.ctypeslib.as_array((getattr(ctypes, name) * n).from_address(ptr))
+    return view.reshape(tuple(arr.arr.shape))
 
 
 def cached(kernel):
