@@ -177,6 +177,22 @@ class Cached:
 _CTYPES = {ti.i32: "c_int32", ti.i64: "c_int64", ti.f32: "c_float", ti.f64: "c_double"}
 
 
+_VIEWS = weakref.WeakKeyDictionary()
+
+
+def host_copy(arr):
+    """``arr.to_numpy()`` for a CPU array of scalars, read through its
+    :func:`host_view` (a copy of the memory, without the copy kernel's launch:
+    microseconds against some 150 µs); other arrays through ``to_numpy``."""
+    view = _VIEWS.get(arr)
+    if view is None:
+        view = host_view(arr)
+        if view is None:
+            return arr.to_numpy()
+        _VIEWS[arr] = view
+    return view.copy()
+
+
 def host_view(arr):
     """A numpy array over the memory of the CPU ``ti.ndarray`` ``arr`` of scalars
     (no copy; valid while ``arr`` lives): reading it costs what reading numpy does,

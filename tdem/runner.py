@@ -327,7 +327,7 @@ class Runner:
         if not self._built:
             return np.array(self._walls_host, dtype=float).reshape(
                 -1, stepk.wall_width(self.dim))
-        return self._a["wall"].to_numpy()[:len(self._walls_host)]
+        return launch.host_copy(self._a["wall"])[:len(self._walls_host)]
 
     def _set_wall_rows(self, rows, fresh=False):
         if not self._built:
@@ -342,7 +342,7 @@ class Runner:
     def _wall_loads(self):
         if not self._built:
             return np.zeros((len(self._walls_host), 4 if self.dim == 2 else 7))
-        return self._a["wforce"].to_numpy()[:len(self._walls_host)]
+        return launch.host_copy(self._a["wforce"])[:len(self._walls_host)]
 
     def _cell_limit(self):
         """Most cells the grid may have: memory stays O(particles) wherever they are."""
@@ -680,7 +680,7 @@ class Runner:
             return np.array([0, 0, 0, 0, 0, 0, 0, 0], np.int32)
         stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["flags"],
                               float(self._dt_run), self.dim)
-        return a["flags"].to_numpy()
+        return launch.host_copy(a["flags"])
 
     def _warn_dense_packing(self, dt):
         """Warn when the step exceeds the stable step of a dense packing of the
