@@ -324,6 +324,7 @@ def run_sweep(tasks, scheduler=None, workers=2, keep=None):
     ``keep``: a folder where each test's result is written as it ends
     (:func:`result_file`); the tests already there are read back instead of run,
     so an interrupted sweep started again goes on where it stopped."""
+    common.dask_distributed()          # no Dask: say how to install it, before anything
     results = [None] * len(tasks)
     if keep is not None:
         from pathlib import Path
