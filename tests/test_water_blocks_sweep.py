@@ -45,3 +45,13 @@ def test_the_table_reports_each_run():
     lines = wb.sweep_table([row]).splitlines()
     assert len(lines) == 3
     assert lines[2] == "| 35° | 25° | 1 mm | slid | 0.234 m | 1.6° | 0.52 s | 4 of 4 |"
+
+
+def test_motion_onset_is_interpolated_between_records():
+    """The block's motion onset: where |dx| crosses 5 mm, linearly between the two
+    records around it; the first record if it starts there; None if never."""
+    t = [0.0, 0.02, 0.04, 0.06]
+    assert wb.motion_onset(t, [0.0, 0.001, 0.009, 0.02]) == pytest.approx(0.03)
+    assert wb.motion_onset(t, [0.0, -0.003, -0.007, 0.0]) == pytest.approx(0.03)
+    assert wb.motion_onset(t, [0.006, 0.01, 0.02, 0.03]) == 0.0
+    assert wb.motion_onset(t, [0.0, 0.001, 0.002, 0.003]) is None
