@@ -51,7 +51,8 @@ Presets
   0.49 to 0.33 m in 1.3 s), because the particles' volumes change only through
   the elements that exist, and the area of the triangles that are deleted as
   the discs slip into the pores of the packing is lost; ``--preset paper
-  --packing random`` is not offered for that reason. Long; not for tests.
+  --packing random`` is not offered for that reason. 82 min on one thread
+  (2026-12-05, both systems; docs/validation.md); not for tests.
 
 Outcome measure. "Stood", "slid" or "toppled" is decided from the top block of
 the rightmost column (largest values over the run): toppled if its rotation
