@@ -22,12 +22,14 @@ else (numpy arrays, keyword arguments, a kernel that returns a value) goes throu
 the plain call. ``TDEM_PLAIN_LAUNCH=1`` turns the fast path off everywhere (read
 when the module is imported and when Taichi is initialised).
 """
+import ctypes
 import functools
 import numbers
 import operator
 import os
 import weakref
 
+import numpy as np
 import taichi as ti
 from taichi.lang import impl
 from taichi.lang._ndarray import Ndarray
@@ -174,41 +176,35 @@ class Cached:
         return e
 
 
-_CTYPES = {ti.i32: "c_int32", ti.i64: "c_int64", ti.f32: "c_float", ti.f64: "c_double"}
-
-
-_VIEWS = weakref.WeakKeyDictionary()
-
-
-def host_copy(arr):
-    """``arr.to_numpy()`` for a CPU array of scalars, read through its
-    :func:`host_view` (a copy of the memory, without the copy kernel's launch:
-    microseconds against some 150 µs); other arrays through ``to_numpy``."""
-    view = _VIEWS.get(arr)
-    if view is None:
-        view = host_view(arr)
-        if view is None:
-            return arr.to_numpy()
-        _VIEWS[arr] = view
-    return view.copy()
+_CTYPES = {ti.i32: ctypes.c_int32, ti.i64: ctypes.c_int64, ti.f32: ctypes.c_float,
+           ti.f64: ctypes.c_double}
+_VIEWS = weakref.WeakKeyDictionary()     # array -> its view (or False: it has none)
 
 
 def host_view(arr):
     """A numpy array over the memory of the CPU ``ti.ndarray`` ``arr`` of scalars
-    (no copy; valid while ``arr`` lives): reading it costs what reading numpy does,
-    against some 10 µs for ``arr[i]``. Kernels on the CPU have finished when their
-    call returns, so the view reads what they wrote. None for other arrays."""
-    import ctypes
+    (no copy; made once per array and valid while it lives): reading it costs what
+    reading numpy does, against some 10 µs for ``arr[i]``. Kernels on the CPU have
+    finished when their call returns, so the view reads what they wrote. None for
+    other arrays (vectors, a GPU's)."""
+    view = _VIEWS.get(arr)
+    if view is None:
+        ct = _CTYPES.get(arr.dtype)
+        view = False
+        if ct is not None and impl.current_cfg().arch in (ti.x64, ti.arm64) and \
+                int(arr.arr.element_size()) == ctypes.sizeof(ct):
+            ptr = int(impl.get_runtime().prog.get_ndarray_data_ptr_as_int(arr.arr))
+            view = np.ctypeslib.as_array((ct * int(arr.arr.nelement())).from_address(ptr))
+            view = view.reshape(tuple(arr.arr.shape))
+        _VIEWS[arr] = view
+    return view if view is not False else None
 
-    import numpy as np
-    name = _CTYPES.get(arr.dtype)
-    if name is None or impl.current_cfg().arch not in (ti.x64, ti.arm64) or \
-            int(arr.arr.element_size()) != ctypes.sizeof(getattr(ctypes, name)):
-        return None
-    n = int(arr.arr.nelement())
-    ptr = int(impl.get_runtime().prog.get_ndarray_data_ptr_as_int(arr.arr))
-    view = np.ctypeslib.as_array((getattr(ctypes, name) * n).from_address(ptr))
-    return view.reshape(tuple(arr.arr.shape))
+
+def host_copy(arr):
+    """``arr.to_numpy()``, read through :func:`host_view` where it has one (a copy of
+    the memory, without the copy kernel's launch: microseconds against some 150 µs)."""
+    view = host_view(arr)
+    return arr.to_numpy() if view is None else view.copy()
 
 
 def cached(kernel):

@@ -590,17 +590,6 @@ class Runner:
         return schema.bind(neighbors.rebuild, self._a, sorted_ids=self._a["sorted"],
                            nwalls=len(self._walls_host), skin=float(self.skin), dim=self.dim)
 
-    def _flags_host(self):
-        """The status flags as the host reads them on the CPU: a numpy view of the
-        device array (:func:`tdem.launch.host_view`), made again when the array is."""
-        arr = self._a["flags"]
-        cache = getattr(self, "_flags_cache", None)
-        if cache is None or cache[0] is not arr:
-            view = launch.host_view(arr)
-            cache = (arr, view if view is not None else arr)
-            self._flags_cache = cache
-        return cache[1]
-
     def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
         """One time step: the stages in the order the data flows (Feng et al.'s seven
         steps). Each stage owns what it writes:
@@ -627,7 +616,8 @@ class Runner:
             cont.prescribed(self)
         # on a GPU the rebuild kernel runs every step and returns at once unless the
         # device raised the flag; on the CPU the host reads the flag (shared memory)
-        if self._n and (not host_reads_flag or self._flags_host()[F_REBUILD] != 0):
+        if self._n and (not host_reads_flag
+                        or launch.host_view(self._a["flags"])[F_REBUILD] != 0):
             (sweep if self.broad_phase == "sweep" else neighbors).rebuild(*rebuild_args)
         if cont is not None:
             cont.pcmm_elements(self, dt, self._reach)
