@@ -341,8 +341,12 @@ def run_sweep(tasks, scheduler=None, workers=2, keep=None):
         return results
 
     def kept(j, r):
-        if keep is not None:
-            save_results(result_file(keep, tasks[todo[j]]), [r])
+        # written under another name, then renamed: a sweep stopped while writing
+        # leaves no half-written result to read back
+        path = result_file(keep, tasks[todo[j]])
+        part = path.with_suffix(".part")
+        save_results(part, [r])
+        os.replace(part, path)
 
     with common.dask_client(scheduler, workers) as client:
         specimens = {}
@@ -355,7 +359,8 @@ def run_sweep(tasks, scheduler=None, workers=2, keep=None):
         done = common.gather_in_order(futures, "biaxial sweep", lambda r: (
             f"{r['name']} at {r['task']['confining'] / 1e3:g} kPa: peak phi "
             f"{r['phi']['phi_peak']:.1f}°, residual {r['phi']['phi_residual']:.1f}° "
-            f"({r['wall_s']:.0f} s)"), each=kept, offset=len(tasks) - len(todo),
+            f"({r['wall_s']:.0f} s)"), each=kept if keep is not None else None,
+            offset=len(tasks) - len(todo),
             total=len(tasks))
     for k, r in zip(todo, done):
         results[k] = r
