@@ -386,7 +386,6 @@ def run_one(cfg, columns, name, out, arch=None, threads=None, folder=None):
         rec["outside"].append(int(np.count_nonzero(~inside)))
         if any(abs(tc - s) < 1e-6 for s in snap_t):
             k = snap_t.index(min(snap_t, key=lambda s: abs(s - tc)))
-            ids = m["water"].ids
             at_paper = k < len(paper_t) and abs(snap_t[k] - paper_t[k]) < 1e-6
             snaps.append({"t": sim.time - t0, "paper_t": paper_t[k] if at_paper else None,
                           "x": p["position"][ids].copy(), "r": p["radius"][ids].copy(),
