@@ -597,6 +597,9 @@ def load(path, arch=None):
                 v = np.concatenate([v, np.zeros((len(v), 1))], axis=1)
             if k in ("psedge", "vsedge") and raw["version"] < 4:
                 v = sim._cont.edges_from_version_3(k[0], v)
+            if k == "ccand" and v.ndim == 2 and arr.shape[1] != v.shape[1]:
+                sim._cont._cells_cap(v.shape[1])     # the saved run's capacity
+                arr = sim._cont.a[k]
             if tuple(arr.shape) != v.shape[:len(arr.shape)]:
                 raise InputError(f"path: checkpoint {str(path)!r} is damaged: "
                                  f"'/continuum/{k}' has shape {v.shape}, expected "

@@ -7,6 +7,7 @@ One step of a model with continua (:meth:`tdem.Simulation._one_step`):
       -> PCMM elements, stresses, nodal forces, gathered     physics.pcmm.update
          (displacements -> rebuild_elements -> mark_dirty -> copies -> incidence
           -> record_slots -> stresses -> equation_of_state -> gather)
+      -> Voronoi water: candidates, cells, pressures, forces  physics.pcmm.cells
       -> block element stresses and nodal forces            physics.blocks.update
       -> DEM contacts + element forces, leapfrog           tdem.step.step
       -> block nodes: damping, prescribed velocities, leapfrog   tdem.nodes
@@ -25,8 +26,9 @@ from coupling import point_edge as pe
 from physics import blocks as blk
 from physics import pcmm
 from physics.materials import JWL, JWL_TYPE, MAT_G, MAT_K, MAT_TYPE, MAT_WIDTH, Fluid
+from physics.pcmm import cells as vcells
 
-from . import backend
+from . import backend, launch
 from .errors import CapacityError, InputError
 from .launch import cached
 from .mesh import nodal_masses
@@ -53,6 +55,11 @@ SAVED_DERIVED = ("earea", "ncov")
 # what a checkpoint saves: the dynamic state and the nodes' initial positions (the rest
 # is set up again from the host description)
 SAVED = _SNAP + ("npos0", "nload")
+# the Voronoi water's candidates (physics.pcmm.cells), where there is such water: kept
+# with the snapshots and checkpoints as PCMM's are (the engine's cell grid they are
+# found in is not)
+_SNAP_CELLS = ("ccand", "cccnt", "cpflags")
+SAVED = SAVED + _SNAP_CELLS
 
 
 @cached
@@ -101,11 +108,16 @@ class Continuum:
     blocks : list of :class:`tdem.simulation.Block`
     """
 
-    def __init__(self, pos, rad, pmat, slots, blocks, capacity=16, couples=()):
+    def __init__(self, pos, rad, pmat, slots, blocks, capacity=16, couples=(), walls=None):
         self.n = len(rad)
         self.slots = slots
         self.blocks = blocks
         self.has_pcmm = bool((pmat >= 0).any())
+        self.walls = np.zeros((0, 4)) if walls is None else np.asarray(walls, float)[:, :4]
+        # the Fluid bodies of Voronoi cells (physics.pcmm.cells): their slot per particle
+        cslots = [s for s, (m, _) in enumerate(slots) if isinstance(m, Fluid) and m.voronoi]
+        self.cmat = np.where(np.isin(pmat, cslots), pmat, -1).astype(np.int32)
+        self.has_cells = bool((self.cmat >= 0).any())
         # the longest Eq. 1 cut-off, 2·max R + max δ (the candidate search's reach)
         self.reach_length = 2.0 * float(np.max(rad, initial=0.0)) + max(
             (t for _, t in slots if t is not None), default=0.0)
@@ -183,6 +195,8 @@ class Continuum:
         a["pflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
         a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
         self._alloc_lists()
+        if self.has_cells:
+            self._alloc_cells()
         self._setup_blocks()
         self._setup_couples(couples)
         self.nr = {}
@@ -230,11 +244,15 @@ class Continuum:
         """Eq. 5 masses and the shortest element altitude of each PCMM body, from
         its element system in the initial configuration."""
         self.masses = np.full(self.n, np.nan)
+        self._cell_a0 = np.full(self.n, np.nan)
         for s, (mat, tol) in enumerate(self.slots):
             if tol is None:
                 continue
             ids = np.flatnonzero(pmat == s)
             if len(ids) == 0:
+                continue
+            if isinstance(mat, Fluid) and mat.voronoi:
+                self._initial_cells(ids, pos, rad, mat, tol)
                 continue
             es = pcmm.ElementSystem(pos[ids], rad[ids], tol).build()
             self.masses[ids] = es.masses(mat.density)
@@ -243,6 +261,64 @@ class Continuum:
             if len(tri):
                 alt = blk.altitudes(pos[ids], tri)
                 self._crit = min(self._crit, float(alt.min()) / mat.p_wave_speed)
+
+    def _initial_cells(self, ids, pos, rad, mat, tol):
+        """A Fluid body of Voronoi cells: masses ρ0 × the initial cells' areas (the
+        body at zero pressure), the Eq. 1 capacity, the step bound (the smallest
+        radius over the sound speed)."""
+        from scipy.spatial import cKDTree
+        x, r = np.ascontiguousarray(pos[ids], float), np.ascontiguousarray(rad[ids], float)
+        tree = cKDTree(x)
+        pairs = tree.query_pairs(2.0 * vcells.REACH * float(r.max()), output_type="ndarray")
+        cand, cnt = _symmetric_lists(len(r), pairs)
+        eq1 = tree.query_pairs(2.0 * float(r.max()) + tol, output_type="ndarray")
+        _, ecount = _symmetric_lists(len(r), eq1)
+        self.capacity = max(self.capacity, 1 << int(ecount.max(initial=1)).bit_length())
+        k = len(r)
+        prop = ti.ndarray(ti.types.vector(3, ti.f64), (k,))
+        prop.from_numpy(np.column_stack([r, np.zeros(k), np.zeros(k)]))
+        area = _cell_run(x, prop, np.zeros(k, np.int32), np.array([[mat.density, 1.0]]),
+                         cand, cnt, self.walls)
+        self.masses[ids] = mat.density * area
+        self._cell_a0[ids] = area
+        self._crit = min(self._crit, float(r.min()) / mat.p_wave_speed)
+
+    def _alloc_cells(self):
+        """The arrays of the Voronoi cells (physics.pcmm.cells); ``cap`` candidates."""
+        a, n = self.a, max(self.n, 1)
+        a["cmat"] = ti.ndarray(ti.i32, (n,))
+        a["cmat"].from_numpy(np.resize(self.cmat, n) if self.n else np.full(1, -1, np.int32))
+        nm = max(len(self.slots), 1)
+        tol = np.zeros(nm)
+        rmax = float(np.max(self.a["rad"].to_numpy(), initial=0.0))
+        # the candidates' cut-off R_i + R_j + δ: the two discs' reach, (REACH − 1)·2·max R over
+        tol[:] = 2.0 * (vcells.REACH - 1.0) * rmax
+        self.cell_reach_length = 2.0 * vcells.REACH * rmax
+        a["cmtol"] = ti.ndarray(ti.f64, (nm,))
+        a["cmtol"].from_numpy(tol)
+        a["crc"] = ti.ndarray(ti.f64, (n,))
+        a["crmax"] = ti.ndarray(ti.f64, (1,))
+        a["crmax"].fill(0.0)
+        a["cpflags"] = ti.ndarray(ti.i32, (pcmm.PFLAGS_SIZE,))
+        a["cpflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
+        self._cells_cap(64)
+        a["carea"] = ti.ndarray(ti.f64, (n,))
+        a["cpres"] = ti.ndarray(ti.f64, (n,))
+        a["cpres"].fill(0.0)
+        a["cnf"] = ti.ndarray(ti.i32, (n,))
+        a["cfj"] = ti.ndarray(ti.i32, (n, vcells.MAX_FACES))
+        a["cfl"] = ti.ndarray(ti.f64, (n, vcells.MAX_FACES))
+        a["cfc"] = _arr(2, (n, vcells.MAX_FACES))
+        a["cbnd"] = _arr(2, (n,))
+        a["cflags"] = ti.ndarray(ti.i32, (1,))
+        a["cflags"].fill(0)
+
+    def _cells_cap(self, cap):
+        a, n = self.a, max(self.n, 1)
+        a["ccand"] = ti.ndarray(ti.i32, (n, cap))
+        a["cccnt"] = ti.ndarray(ti.i32, (n,))
+        a["cccnt"].fill(0)
+        a["cpflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
 
     def _alloc_lists(self):
         n, cap = max(self.n, 1), self.capacity
@@ -574,6 +650,57 @@ class Continuum:
                     self._full or sim.steps <= 1, self.carry_stress, self.eos, sim._serial())
         self._full = False
 
+    def cell_pressure(self, sim, reach):
+        """Stage, after the PCMM update (which gave the cell particles their core
+        forces and pair marks): the Voronoi cells' candidates (only after a list
+        build), areas, pressures and forces, added to ``xforce``
+        (physics.pcmm.cells)."""
+        if not self.has_cells:
+            return
+        a, e = self.a, sim._a
+        serial = sim._serial()
+        while True:
+            pcmm.candidates(e["pos"], a["rad"], a["crc"], a["crmax"], a["cmat"], a["cmtol"],
+                            a["ccand"], a["cccnt"], e["cell_count"], e["cell_start"],
+                            e["sorted"], e["gridp"], e["gridn"], e["flags"], a["cpflags"],
+                            F_BUILDS, float(sim.skin), int(reach))
+            need = int(launch.host_view(a["cpflags"])[pcmm.P_NEED])
+            cap = a["ccand"].shape[1]
+            if need <= cap:
+                break
+            if need > MAX_CANDIDATES:
+                raise CapacityError(f"a water particle has {need} cell candidates, more than "
+                                    f"{MAX_CANDIDATES}: are its radii far apart?")
+            self._cells_cap(1 << int(need).bit_length())
+        walls = e.get("wall")
+        nw = len(sim._walls_host)
+        if walls is None or nw == 0:
+            walls = a.get("cnowall")
+            if walls is None:
+                walls = a["cnowall"] = ti.ndarray(ti.f64, (1, 4))
+            nw = 0
+        vcells.cells(e["pos"], e["prop"], a["cmat"], a["matp"], a["ccand"], a["cccnt"],
+                     walls, nw, a["carea"], a["cpres"], a["cnf"], a["cfj"], a["cfl"], a["cfc"],
+                     a["cbnd"], a["cflags"], serial)
+        faces = int(launch.host_view(a["cflags"])[0])
+        if faces > vcells.MAX_FACES:
+            raise CapacityError(f"a water particle's Voronoi cell has {faces} faces, more than "
+                                f"{vcells.MAX_FACES}: are its neighbours' radii far smaller "
+                                "than its own?")
+        vcells.cell_forces(e["pos"], e["vel"], a["cmat"], a["matp"], a["ccand"], a["cccnt"],
+                           a["cpres"], a["cnf"], a["cfj"], a["cfl"], a["cfc"], a["cbnd"],
+                           a["xforce"], a["psig"], serial)
+
+    def cell_state(self):
+        """The Voronoi cells now: area (N,), pressure (N,), body slot (N,; −1 for
+        particles of no such body); zeros when there are none."""
+        if not self.has_cells:
+            z = np.zeros(self.n)
+            return {"area": z, "pressure": z, "cmat": np.full(self.n, -1)}
+        a = self.a
+        return {"area": a["carea"].to_numpy()[:self.n], "pressure": a["cpres"].to_numpy()[:self.n],
+                "cmat": self.cmat[:self.n].copy()}
+
     def eos_volumes(self, sim, dt):
         """Stage, after the particles moved: each particle with an equation of state
         keeps the volume change of the step by the elements that pushed over it
@@ -724,6 +851,12 @@ class Continuum:
                                       ti.ndarray(src.dtype, tuple(src.shape)))
             if k not in _SNAP_PARTICLES:
                 dst.copy_from(src)
+        for k in _SNAP_CELLS if self.has_cells else ():
+            src = self.a[k]
+            dst = self.snap.get(k)
+            if dst is None or tuple(dst.shape) != tuple(src.shape):
+                dst = self.snap[k] = ti.ndarray(src.dtype, tuple(src.shape))
+            dst.copy_from(src)
         serial = backend.serial_loops(self.n, True)
         copy_particles(*[self.a[k] for k in _SNAP_PARTICLES],
                        *[self.snap[k] for k in _SNAP_PARTICLES], serial)
@@ -743,6 +876,13 @@ class Continuum:
                            *[self.a[k] for k in _SNAP_PARTICLES], serial)
         if self.snap.get("cand") is None:
             self.a["pflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
+        if self.has_cells:
+            if all(self.snap.get(k) is not None and tuple(self.snap[k].shape) ==
+                   tuple(self.a[k].shape) for k in _SNAP_CELLS):
+                for k in _SNAP_CELLS:
+                    self.a[k].copy_from(self.snap[k])
+            else:       # (grown since: found again)
+                self.a["cpflags"].from_numpy(np.array(pcmm.PFLAGS_INIT, np.int32))
         # the map of copies belongs to the elements before the restore: every restored
         # slot holds its own (synced) stress until the next step maps them again
         self.a["emult"].fill(1)
@@ -810,6 +950,16 @@ class Continuum:
             if len(e["owner"]):
                 mat = self.a["pmat"].to_numpy()[e["owner"]]
                 total += _stored(e["stress"], e["stress_zz"], rows[mat], e["area"] * e["weight"])
+        if self.has_cells:
+            # Σ A0 K (V − 1 − ln V) over the compressed cells (physics.pcmm.cells)
+            c = self.cell_state()
+            sel = np.flatnonzero(c["cmat"] >= 0)
+            if len(sel):
+                a0 = self._cell_a0[sel]
+                v = c["area"][sel] / a0
+                k = rows[c["cmat"][sel], MAT_K]
+                total += float(np.sum(np.where(v < 1.0, a0 * k * (v - 1.0 - np.log(
+                    np.minimum(v, 1.0))), 0.0)))
         if self.nt:
             x = self.a["npos"].to_numpy()
             for b in self.blocks:
@@ -976,3 +1126,52 @@ def _tensor(s4):
     out[:, 0, 0], out[:, 1, 1] = s4[:, 0], s4[:, 1]
     out[:, 0, 1] = out[:, 1, 0] = s4[:, 2]
     return out
+
+
+def _symmetric_lists(n, pairs):
+    """Each index's partners (N, cap; −1 padded) and their count from a pair list."""
+    a = np.concatenate([pairs[:, 0], pairs[:, 1]]).astype(np.int64)
+    b = np.concatenate([pairs[:, 1], pairs[:, 0]]).astype(np.int64)
+    o = np.argsort(a, kind="stable")
+    a, b = a[o], b[o]
+    cnt = np.bincount(a, minlength=n)
+    start = np.cumsum(cnt) - cnt
+    lists = np.full((n, max(int(cnt.max(initial=0)), 1)), -1, np.int32)
+    lists[a, np.arange(len(a)) - start[a]] = b
+    return lists, cnt.astype(np.int32)
+
+
+def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls):
+    """The cells' areas of particles ``pos`` (one body, candidates ``cand``) with the
+    kernel of the step (the set-up's, before the engine's arrays exist)."""
+    n = len(pos)
+    A = {}
+    A["pos"] = _arr(2, (n,))
+    A["pos"].from_numpy(pos)
+    A["cmat"] = ti.ndarray(ti.i32, (n,))
+    A["cmat"].from_numpy(cmat)
+    rows = np.zeros((len(matp_rows), MAT_WIDTH))
+    from physics.materials import MAT_RHO
+    rows[:, MAT_RHO] = matp_rows[:, 0]
+    rows[:, MAT_K] = matp_rows[:, 1]
+    A["matp"] = ti.ndarray(ti.f64, rows.shape)
+    A["matp"].from_numpy(rows)
+    A["cand"] = ti.ndarray(ti.i32, cand.shape)
+    A["cand"].from_numpy(cand)
+    A["cnt"] = ti.ndarray(ti.i32, (n,))
+    A["cnt"].from_numpy(cnt)
+    w = np.zeros((max(len(walls), 1), 4))
+    w[:len(walls)] = walls
+    A["wall"] = ti.ndarray(ti.f64, w.shape)
+    A["wall"].from_numpy(w)
+    out = {k: ti.ndarray(ti.f64, (n,)) for k in ("area", "pres")}
+    nf = ti.ndarray(ti.i32, (n,))
+    fj = ti.ndarray(ti.i32, (n, vcells.MAX_FACES))
+    fl = ti.ndarray(ti.f64, (n, vcells.MAX_FACES))
+    fc = _arr(2, (n, vcells.MAX_FACES))
+    bnd = _arr(2, (n,))
+    flags = ti.ndarray(ti.i32, (1,))
+    flags.fill(0)
+    vcells.cells(A["pos"], prop, A["cmat"], A["matp"], A["cand"], A["cnt"], A["wall"],
+                 len(walls), out["area"], out["pres"], nf, fj, fl, fc, bnd, flags, False)
+    return out["area"].to_numpy()

@@ -250,6 +250,20 @@ class Results:
                 "shear": np.zeros(0), "broken": np.zeros(0, bool), "kind": np.zeros(0, int)}
         return self._cont.point_edge_contacts(pos)
 
+    def water_cells(self):
+        """The Voronoi cells of the water of ``Fluid(voronoi=True)`` bodies
+        (:mod:`physics.pcmm.cells`) at the last completed step, per particle: area (N,)
+        m² per metre of thickness, pressure (N,) Pa, and water (N,) bool, the
+        particles of such bodies (the others read area and pressure 0)."""
+        self._require_built()
+        if self._cont is None:
+            z = np.zeros(self._n)
+            return {"area": z, "pressure": z.copy(), "water": np.zeros(self._n, bool)}
+        c = self._cont.cell_state()
+        water = c["cmat"] >= 0
+        return {"area": np.where(water, c["area"], 0.0),
+                "pressure": np.where(water, c["pressure"], 0.0), "water": water}
+
     def energy(self):
         """Energy account (J per metre of thickness) at the last completed step:
         kinetic, gravitational (relative to the origin), elastic (contact springs),

@@ -198,7 +198,9 @@ class Runner:
             pmat = np.concatenate(self._host["mat"]).astype(np.int64)
         else:
             pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
-        return Continuum(pos, rad, pmat, self._slots, self._blocks, couples=self._couple_rows())
+        walls = np.array(self._walls_host, float).reshape(-1, stepk.wall_width(self.dim))
+        return Continuum(pos, rad, pmat, self._slots, self._blocks, couples=self._couple_rows(),
+                         walls=walls)
 
     def _require_built(self):
         if not self._built:
@@ -558,9 +560,13 @@ class Runner:
 
     def _engine_args(self):
         """Arguments of the step and rebuild kernels; the PCMM candidate search reach."""
+        self._creach = 1
         if self._cont is not None and self._cont.has_pcmm:
             h = float(self._a["gridp"].to_numpy()[2])
             self._reach = max(1, int(math.ceil((self._cont.reach_length + 2 * self.skin) / h)))
+            if self._cont.has_cells:
+                self._creach = max(1, int(math.ceil((self._cont.cell_reach_length
+                                                     + 2 * self.skin) / h)))
         else:
             self._reach = 1
         if self._n == 0:
@@ -596,7 +602,8 @@ class Runner:
 
         1. prescribed velocities (functions of time) uploaded — ``vfix``, node fixes;
         2. neighbour lists rebuilt when the skin check asked — slots and histories;
-        3. PCMM elements (physics.pcmm) — element stresses, ``xforce``;
+        3. PCMM elements (physics.pcmm) — element stresses, ``xforce``; the Voronoi
+           cells of water (physics.pcmm.cells) — their pressures, ``xforce``;
         4. blocks (physics.blocks) — triangle stresses, ``nforce``;
         5. point–edge contacts (coupling) — ``xforce``, ``nforce``;
         6. viscous (non-reflecting) boundaries — ``xforce``, ``nforce``;
@@ -621,6 +628,7 @@ class Runner:
             (sweep if self.broad_phase == "sweep" else neighbors).rebuild(*rebuild_args)
         if cont is not None:
             cont.pcmm_elements(self, dt, self._reach)
+            cont.cell_pressure(self, self._creach)
             cont.block_stresses(self, dt)
             cont.point_edge(self, dt)
             cont.viscous_boundaries(self)

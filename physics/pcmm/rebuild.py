@@ -18,7 +18,7 @@ date before the host reads or saves them.
 """
 import taichi as ti
 
-from physics.materials import JWL_SWELL, JWL_TYPE, MAT_TYPE
+from physics.materials import FLUID, JWL_SWELL, JWL_TYPE, MAT_CELLS, MAT_TYPE
 from tdem.launch import cached
 from tdem.neighbors import F_REBUILD
 
@@ -224,7 +224,8 @@ def swell(pmat: ti.types.ndarray(), matp: ti.types.ndarray(), rad: ti.types.ndar
 @cached
 @ti.kernel
 def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
-                     pmat: ti.types.ndarray(), mtol: ti.types.ndarray(),
+                     pmat: ti.types.ndarray(), matp: ti.types.ndarray(),
+                     mtol: ti.types.ndarray(),
                      cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
                      nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(),
                      ring: ti.types.ndarray(), rang: ti.types.ndarray(),
@@ -314,8 +315,14 @@ def rebuild_elements(pos: ti.types.ndarray(), rad: ti.types.ndarray(),
                     elem_old[i, s, 0] = elem[i, s, 0]
                     elem_old[i, s, 1] = elem[i, s, 1]
                     esig_old[i, s] = _stress_of(i, s, sigp, eidx, esig, emult, ecopy)
-                r, rs = _ring(i, xi, cnt, pos, nbr, ring, rang)
-                ne, cs = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
+                rs = 1e300
+                cs = 1e300
+                ne = 0
+                if not (ti.cast(matp[m, MAT_TYPE], ti.i32) == FLUID and matp[m, MAT_CELLS] > 0.0):
+                    # (a Fluid of Voronoi cells makes no elements: physics.pcmm.cells)
+                    r, rs0 = _ring(i, xi, cnt, pos, nbr, ring, rang)
+                    rs = rs0
+                    ne, cs = _create(i, r, xi, ri, tol, pos, rad, ring, elem, earea)
                 ecnt[i] = ne
                 for s in range(ne):
                     src = -1

@@ -23,7 +23,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
     full = int(bool(full) or bool(first))
     a["sigp"], a["sigc"] = a["sigc"], a["sigp"]       # last step's stresses, this step's
     displacements(e["pos"], a["pmat"], a["xref"], a["pu"], a["pflags"], full, serial)
-    rebuild_elements(e["pos"], a["rrule"], a["pmat"], a["mtol"], a["cand"], a["ccnt"],
+    rebuild_elements(e["pos"], a["rrule"], a["pmat"], a["matp"], a["mtol"], a["cand"], a["ccnt"],
                      a["nbr"], a["ncnt"], a["ring"], a["rang"], a["elem"], a["ecnt"],
                      a["earea"], a["esig"], a["sigp"], a["eidx"], a["elem_old"], a["esig_old"],
                      a["ecnt_old"],
