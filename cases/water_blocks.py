@@ -50,9 +50,12 @@ Presets
   loses volume as it flows (a column of R = 6-14 mm discs, δ = 5 mm, sank from
   0.49 to 0.33 m in 1.3 s), because the particles' volumes change only through
   the elements that exist, and the area of the triangles that are deleted as
-  the discs slip into the pores of the packing is lost; ``--preset paper
-  --packing random`` is not offered for that reason. 82 min on one thread
+  the discs slip into the pores of the packing is lost. 82 min on one thread
   (2026-12-05, both systems; docs/validation.md); not for tests.
+- ``--water cells`` (either preset): the water packed at random as the paper's
+  is, as Voronoi cells (``tdem.Fluid(voronoi=True)``, ``physics.pcmm.cells``),
+  which hold at rest and keep their area as they flow on any packing. Quick: R = 1.4-2.6 cm, 660 discs at 76 % of the column; paper: the
+  paper's 5528 discs of R = 3-8 mm (50 % of the column: the cells fill the rest).
 
 Outcome measure. "Stood", "slid" or "toppled" is decided from the top block of
 the rightmost column (largest values over the run): toppled if its rotation
@@ -160,6 +163,16 @@ PRESETS = {
 }
 
 
+#: ``--water cells``: water of Voronoi cells (``tdem.Fluid(voronoi=True)``), packed at
+#: random as the paper's is (radii uniform in [rmin, rmax])
+CELLS = {
+    "quick": {"packing": "random", "rmin": 0.014, "rmax": 0.026, "count": 660,
+              "tolerance": 0.02, "voronoi": True},
+    "paper": {"packing": "random", "rmin": 0.003, "rmax": 0.008, "count": 5528,
+              "tolerance": 0.0055, "voronoi": True},
+}
+
+
 def water_particles(cfg):
     """Centres and radii of the water column [0, 0.8] × [0, 1.4]."""
     if cfg["packing"] == "regular":
@@ -187,7 +200,7 @@ def build(cfg, columns, arch=None, threads=None):
     sim = tdem.Simulation(gravity=(0.0, -9.81), dt_fraction=cfg["dt_fraction"],
                           local_damping=0.7, arch=arch, **({"threads": threads} if threads else {}))
     water = tdem.Fluid(density=RHO_W, bulk_modulus=cfg["bulk"], viscosity=cfg["viscosity"],
-                       linear_viscosity=cfg["b1"])
+                       linear_viscosity=cfg["b1"], voronoi=cfg.get("voronoi", False))
     pos, rad = water_particles(cfg)
     wlaw = tdem.LinearContact(kn=3.0 * cfg["bulk"], ks=0.0, friction=0.0)
     g = sim.add_particles(pos, rad, material=water, tolerance=cfg["tolerance"], contact=wlaw)
@@ -403,10 +416,17 @@ def run_one(cfg, columns, name, out, arch=None, threads=None, folder=None):
     return res
 
 
-def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=("four", "two")):
-    """Run the case; returns the summary dict (also written to ``out/summary.json``)."""
+def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=("four", "two"),
+        water="elements"):
+    """Run the case; returns the summary dict (also written to ``out/summary.json``).
+    ``water``: "elements" (the presets' lattice water) or "cells" (:data:`CELLS`)."""
     clock = common.Stopwatch()
     cfg = dict(PRESETS[preset])
+    if water == "cells":
+        cfg.update(CELLS[preset])
+    elif water != "elements":
+        from tdem.errors import InputError
+        raise InputError(f"water must be 'elements' or 'cells', got {water!r}")
     if duration is not None:
         cfg["duration"] = float(duration)
     out = common.output_dir(CASE, out)
@@ -474,6 +494,7 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
     data = {
         "model": {"water_particles": {k: r["n"] for k, r in results.items()},
                   "paper_water_particles": 5528, "packing": cfg["packing"],
+                  "water": water,
                   "bulk_modulus_Pa": cfg["bulk"], "sound_speed_m_s": c,
                   "front_speed_2sqrt_gH": 2.0 * math.sqrt(9.81 * WATER_H),
                   "blocks": "rigid", "block_contact_kn": BLOCK_KN,
@@ -598,6 +619,11 @@ def plot_sweep(rows, png):
 
 
 def _extra(p):
+    p.add_argument("--water", choices=("elements", "cells"), default="elements",
+                   help="elements: the presets' water on a square lattice (PCMM elements); "
+                        "cells: water of Voronoi cells (tdem.Fluid(voronoi=True)) packed at "
+                        "random, R = 1.4-2.6 cm (quick) or the paper's 5528 discs of 3-8 mm "
+                        "(paper)")
     p.add_argument("--sweep", action="store_true",
                    help="four columns over the parameters the paper does not give (floor "
                         "and block friction, column gap; cases.water_blocks.SWEEP) at the "
@@ -636,7 +662,7 @@ def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
     if args.sweep:
         return main_sweep(args, out)
-    s = run(args.preset, out, arch=args.arch, threads=args.threads)
+    s = run(args.preset, out, arch=args.arch, threads=args.threads, water=args.water)
     common.print_checks(s)
     print(f"summary: {out / 'summary.json'}")
     return 0

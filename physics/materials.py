@@ -333,8 +333,9 @@ class Fluid(Material):
         the area A of its Voronoi cell among the particles of its body (cut by the
         walls and by a disc of 2.5 R), A0 = m/ρ0, the masses ρ0 × the cells of the
         initial packing (:mod:`physics.pcmm.cells`); ``viscosity`` acts between
-        neighbouring cells, μ Σ (l/d)(v_j − v_i). Not with ``equation_of_state``,
-        the artificial bulk viscosities, ``tensile_strength`` or a shear modulus.
+        neighbouring cells, μ Σ (l/d)(v_j − v_i), and the artificial bulk viscosities
+        on each shrinking cell as on an element. Not with ``equation_of_state``,
+        ``tensile_strength`` or a shear modulus.
         It is the option for water packed at random (below).
 
     Contacts between water particles. Two particles of one Fluid body that are
@@ -527,8 +528,7 @@ class Fluid(Material):
             raise InputError(f"voronoi must be True or False, got {voronoi!r}")
         self.voronoi = bool(voronoi)
         if self.voronoi:
-            for name in ("linear_viscosity", "quadratic_viscosity", "tensile_strength",
-                         "shear_modulus", "relaxation_time"):
+            for name in ("tensile_strength", "shear_modulus", "relaxation_time"):
                 if getattr(self, name) != 0.0:
                     raise InputError(f"{name}={getattr(self, name)!r} is an option of the "
                                      f"elements' pressure: it cannot be used with voronoi=True")

@@ -278,7 +278,7 @@ class Continuum:
         prop = ti.ndarray(ti.types.vector(3, ti.f64), (k,))
         prop.from_numpy(np.column_stack([r, np.zeros(k), np.zeros(k)]))
         area = _cell_run(x, prop, np.zeros(k, np.int32), np.array([[mat.density, 1.0]]),
-                         cand, cnt, self.walls)
+                         cand, cnt, self.walls)["area"]
         self.masses[ids] = mat.density * area
         self._cell_a0[ids] = area
         self._crit = min(self._crit, float(r.min()) / mat.p_wave_speed)
@@ -305,6 +305,8 @@ class Continuum:
         a["carea"] = ti.ndarray(ti.f64, (n,))
         a["cpres"] = ti.ndarray(ti.f64, (n,))
         a["cpres"].fill(0.0)
+        a["cq"] = ti.ndarray(ti.f64, (n,))
+        a["cq"].fill(0.0)
         a["cnf"] = ti.ndarray(ti.i32, (n,))
         a["cfj"] = ti.ndarray(ti.i32, (n, vcells.MAX_FACES))
         a["cfl"] = ti.ndarray(ti.f64, (n, vcells.MAX_FACES))
@@ -679,17 +681,17 @@ class Continuum:
             if walls is None:
                 walls = a["cnowall"] = ti.ndarray(ti.f64, (1, 4))
             nw = 0
-        vcells.cells(e["pos"], e["prop"], a["cmat"], a["matp"], a["ccand"], a["cccnt"],
-                     walls, nw, a["carea"], a["cpres"], a["cnf"], a["cfj"], a["cfl"], a["cfc"],
-                     a["cbnd"], a["cflags"], serial)
+        vcells.cells(e["pos"], e["vel"], e["prop"], a["cmat"], a["matp"], a["ccand"],
+                     a["cccnt"], walls, nw, a["carea"], a["cpres"], a["cq"], a["cnf"], a["cfj"],
+                     a["cfl"], a["cfc"], a["cbnd"], a["cflags"], serial)
         faces = int(launch.host_view(a["cflags"])[0])
         if faces > vcells.MAX_FACES:
             raise CapacityError(f"a water particle's Voronoi cell has {faces} faces, more than "
                                 f"{vcells.MAX_FACES}: are its neighbours' radii far smaller "
                                 "than its own?")
         vcells.cell_forces(e["pos"], e["vel"], a["cmat"], a["matp"], a["ccand"], a["cccnt"],
-                           a["cpres"], a["cnf"], a["cfj"], a["cfl"], a["cfc"], a["cbnd"],
-                           a["xforce"], a["psig"], serial)
+                           a["cpres"], a["cq"], a["cnf"], a["cfj"], a["cfl"], a["cfc"],
+                           a["cbnd"], a["xforce"], a["psig"], serial)
 
     def cell_state(self):
         """The Voronoi cells now: area (N,), pressure (N,), body slot (N,; −1 for
@@ -1141,19 +1143,26 @@ def _symmetric_lists(n, pairs):
     return lists, cnt.astype(np.int32)
 
 
-def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls):
-    """The cells' areas of particles ``pos`` (one body, candidates ``cand``) with the
-    kernel of the step (the set-up's, before the engine's arrays exist)."""
+def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls, vel=None):
+    """The cells of particles ``pos`` (one body, candidates ``cand``; ``matp_rows``
+    (ρ0, K, b1) per body, ``vel`` their velocities, default at rest) with the kernel
+    of the step (the set-up's, before the engine's arrays exist): area, pressure and
+    bulk viscosity per particle."""
+    from physics.materials import MAT_B1, MAT_RHO
     n = len(pos)
     A = {}
     A["pos"] = _arr(2, (n,))
     A["pos"].from_numpy(pos)
+    A["vel"] = _arr(2, (n,))
+    A["vel"].from_numpy(np.zeros((n, 2)) if vel is None else np.asarray(vel, float))
     A["cmat"] = ti.ndarray(ti.i32, (n,))
     A["cmat"].from_numpy(cmat)
-    rows = np.zeros((len(matp_rows), MAT_WIDTH))
-    from physics.materials import MAT_RHO
-    rows[:, MAT_RHO] = matp_rows[:, 0]
-    rows[:, MAT_K] = matp_rows[:, 1]
+    mr = np.atleast_2d(np.asarray(matp_rows, float))
+    rows = np.zeros((len(mr), MAT_WIDTH))
+    rows[:, MAT_RHO] = mr[:, 0]
+    rows[:, MAT_K] = mr[:, 1]
+    if mr.shape[1] > 2:
+        rows[:, MAT_B1] = mr[:, 2]
     A["matp"] = ti.ndarray(ti.f64, rows.shape)
     A["matp"].from_numpy(rows)
     A["cand"] = ti.ndarray(ti.i32, cand.shape)
@@ -1164,7 +1173,7 @@ def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls):
     w[:len(walls)] = walls
     A["wall"] = ti.ndarray(ti.f64, w.shape)
     A["wall"].from_numpy(w)
-    out = {k: ti.ndarray(ti.f64, (n,)) for k in ("area", "pres")}
+    out = {k: ti.ndarray(ti.f64, (n,)) for k in ("area", "pres", "q")}
     nf = ti.ndarray(ti.i32, (n,))
     fj = ti.ndarray(ti.i32, (n, vcells.MAX_FACES))
     fl = ti.ndarray(ti.f64, (n, vcells.MAX_FACES))
@@ -1172,6 +1181,7 @@ def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls):
     bnd = _arr(2, (n,))
     flags = ti.ndarray(ti.i32, (1,))
     flags.fill(0)
-    vcells.cells(A["pos"], prop, A["cmat"], A["matp"], A["cand"], A["cnt"], A["wall"],
-                 len(walls), out["area"], out["pres"], nf, fj, fl, fc, bnd, flags, False)
-    return out["area"].to_numpy()
+    vcells.cells(A["pos"], A["vel"], prop, A["cmat"], A["matp"], A["cand"], A["cnt"],
+                 A["wall"], len(walls), out["area"], out["pres"], out["q"], nf, fj, fl, fc,
+                 bnd, flags, False)
+    return {k: v.to_numpy() for k, v in out.items()}

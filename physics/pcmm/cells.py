@@ -52,7 +52,7 @@ import taichi as ti
 from tdem.launch import cached
 from tdem.state import PROP_MASS, PROP_RADIUS
 
-from ..materials import MAT_K, MAT_RHO, MAT_VISC
+from ..materials import MAT_B1, MAT_B2, MAT_K, MAT_RHO, MAT_VISC
 
 REACH = 2.5        # the bounding disc's radius, in particle radii
 SIDES = 24         # the bounding disc as a regular polygon
@@ -104,16 +104,23 @@ def _clip(px: ti.template(), py: ti.template(), lab: ti.template(), nv, a, b, la
 
 @cached
 @ti.kernel
-def cells(pos: ti.types.ndarray(), prop: ti.types.ndarray(), cmat: ti.types.ndarray(),
+def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarray(),
+          cmat: ti.types.ndarray(),
           matp: ti.types.ndarray(), cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
           wall: ti.types.ndarray(), nwalls: ti.i32, carea: ti.types.ndarray(),
-          cpres: ti.types.ndarray(), cnf: ti.types.ndarray(), cfj: ti.types.ndarray(),
+          cpres: ti.types.ndarray(), cq: ti.types.ndarray(), cnf: ti.types.ndarray(),
+          cfj: ti.types.ndarray(),
           cfl: ti.types.ndarray(), cfc: ti.types.ndarray(), cbnd: ti.types.ndarray(),
           cflags: ti.types.ndarray(), serial: ti.template()):
     """Each cell particle's cell: its area (``carea``), pressure (``cpres``), faces
     (``cnf`` of them: neighbour ``cfj``, length ``cfl``, midpoint ``cfc``) and Σ l n
     over its arcs (``cbnd``). ``cflags[0]``: the largest face count met (a cell
-    with more faces than MAX_FACES is an error the host raises)."""
+    with more faces than MAX_FACES is an error the host raises).
+
+    ``cq``: the artificial bulk viscosity of a shrinking cell, q = ρ L r (b1 c + b2
+    L r) with r = −(dA/dt)/A, L = sqrt(A) (the elements' form,
+    :func:`physics.pcmm.stress.bulk_viscosity`); dA/dt = Σ_k ∂A/∂x_k · v_k from the
+    same faces. It pushes as the pressure does and is not part of it."""
     ti.loop_config(serialize=serial)
     for i in range(cmat.shape[0]):
         M = cmat[i]
@@ -151,6 +158,8 @@ def cells(pos: ti.types.ndarray(), prop: ti.types.ndarray(), cmat: ti.types.ndar
             area = 0.0
             bnd = ti.Vector([0.0, 0.0])
             nf = 0
+            rate = 0.0      # dA/dt
+            vi = vel[i]
             for k in range(nv):
                 k1 = (k + 1) % nv
                 area += 0.5 * (px[k] * py[k1] - px[k1] * py[k])
@@ -158,29 +167,45 @@ def cells(pos: ti.types.ndarray(), prop: ti.types.ndarray(), cmat: ti.types.ndar
                 if lab[k] == NO_FACE:
                     bnd += ti.Vector([t[1], -t[0]])
                 elif lab[k] >= 0:
+                    j = lab[k]
+                    mid = ti.Vector([0.5 * (px[k] + px[k1]), 0.5 * (py[k] + py[k1])])
+                    ln = t.norm()
+                    rate += ln / (pos[j] - xi).norm() * ((mid - xi).dot(vi)
+                                                        - (mid - pos[j]).dot(vel[j]))
                     if nf < MAX_FACES:
-                        cfj[i, nf] = lab[k]
-                        cfl[i, nf] = t.norm()
-                        cfc[i, nf] = ti.Vector([0.5 * (px[k] + px[k1]), 0.5 * (py[k] + py[k1])])
+                        cfj[i, nf] = j
+                        cfl[i, nf] = ln
+                        cfc[i, nf] = mid
                     nf += 1
+            rate += bnd.dot(vi)
             ti.atomic_max(cflags[0], nf)
             cnf[i] = ti.min(nf, MAX_FACES)
             carea[i] = area
             cbnd[i] = bnd
-            a0 = prop[i][PROP_MASS] / matp[M, MAT_RHO]
+            rho = matp[M, MAT_RHO]
+            a0 = prop[i][PROP_MASS] / rho
             cpres[i] = matp[M, MAT_K] * ti.max(a0 / area - 1.0, 0.0) if area > 0.0 else 0.0
+            q = 0.0
+            b1 = matp[M, MAT_B1]
+            b2 = matp[M, MAT_B2]
+            if rate < 0.0 and b1 + b2 > 0.0 and area > 0.0:
+                L = ti.sqrt(area)
+                r = -rate / area
+                q = rho * L * r * (b1 * ti.sqrt(matp[M, MAT_K] / rho) + b2 * L * r)
+            cq[i] = q
 
 
 @cached
 @ti.kernel
 def cell_forces(pos: ti.types.ndarray(), vel: ti.types.ndarray(), cmat: ti.types.ndarray(),
                 matp: ti.types.ndarray(), cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
-                cpres: ti.types.ndarray(), cnf: ti.types.ndarray(), cfj: ti.types.ndarray(),
+                cpres: ti.types.ndarray(), cq: ti.types.ndarray(), cnf: ti.types.ndarray(),
+                cfj: ti.types.ndarray(),
                 cfl: ti.types.ndarray(), cfc: ti.types.ndarray(), cbnd: ti.types.ndarray(),
                 xforce: ti.types.ndarray(), psig: ti.types.ndarray(), serial: ti.template()):
     """F_i = p_i ∂A_i/∂x_i + Σ_j p_j ∂A_j/∂x_i (the module docstring) plus the
-    viscous force, added to ``xforce``; the particle's stress (−p, −p, 0, −p) into
-    ``psig``. The second sum runs over i's candidates and reads each one's own face
+    viscous force, added to ``xforce``, with p + q for p (``cq``, the bulk
+    viscosity); the particle's stress (−p, −p, 0, −p) into ``psig``. The second sum runs over i's candidates and reads each one's own face
     with i (the two discs can cut a face differently, or away from one cell); the
     viscosity takes the mean of the two cells' lengths of a face, so that it is
     the same for both particles."""
@@ -190,7 +215,7 @@ def cell_forces(pos: ti.types.ndarray(), vel: ti.types.ndarray(), cmat: ti.types
         if M >= 0:
             xi = pos[i]
             vi = vel[i]
-            pi = cpres[i]
+            pi = cpres[i] + cq[i]
             mu = matp[M, MAT_VISC]
             f = pi * cbnd[i]
             for k in range(cnf[i]):
@@ -210,7 +235,8 @@ def cell_forces(pos: ti.types.ndarray(), vel: ti.types.ndarray(), cmat: ti.types
                 if lji > 0.0 or lij > 0.0:
                     d = (pos[j] - xi).norm()
                     if lji > 0.0:
-                        f -= cpres[j] * lji / d * (cji - xi)
+                        f -= (cpres[j] + cq[j]) * lji / d * (cji - xi)
                     f += mu * 0.5 * (lij + lji) / d * (vel[j] - vi)
             xforce[i] = xforce[i] + f
-            psig[i] = ti.Vector([-pi, -pi, 0.0, -pi])
+            pe = cpres[i]
+            psig[i] = ti.Vector([-pe, -pe, 0.0, -pe])
