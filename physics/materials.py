@@ -331,11 +331,11 @@ class Fluid(Material):
     voronoi : False (default): the pressure of the elements (above). True: the
         body makes no elements; each particle's pressure is K·max(A0/A − 1, 0) from
         the area A of its Voronoi cell among the particles of its body (cut by the
-        walls and by a disc of 2.5 R), A0 = m/ρ0, the masses ρ0 × the cells of the
-        initial packing (:mod:`physics.pcmm.cells`); ``viscosity`` acts between
-        neighbouring cells, μ Σ (l/d)(v_j − v_i), and the artificial bulk viscosities
-        on each shrinking cell as on an element. Not with ``equation_of_state``,
-        ``tensile_strength`` or a shear modulus.
+        walls and by a disc of 2.5 × the body's mean radius), A0 = m/ρ0, the
+        masses ρ0 × the cells of the initial packing (:mod:`physics.pcmm.cells`);
+        ``viscosity`` acts between neighbouring cells, μ Σ (l/d)(v_j − v_i), and
+        the artificial bulk viscosities on each shrinking cell as on an element.
+        Not with ``equation_of_state``, ``tensile_strength`` or a shear modulus.
         It is the option for water packed at random (below).
 
     Contacts between water particles. Two particles of one Fluid body that are
@@ -467,22 +467,22 @@ class Fluid(Material):
     the surface end):
 
     ========== =============== ============================ ========== ==========
-    packing    largest speed   p against ρg·depth           area       elements
-               (× sqrt(gh))
+    packing    largest speed   p against ρg·depth, below    area       elements
+               (× sqrt(gh))    the top row
     ========== =============== ============================ ========== ==========
-    square     3e-6            0.24 % below the top row     −0.25 %    none
-    hexagonal  5e-5            0.24 % below the top row     −0.25 %    none
-    random     6e-3            1.2 % from 10 R down; 5.8 %  −0.25 %    none
-                               between 2.5 R and 10 R
+    square     3e-6            0.24 %                       −0.25 %    none
+    hexagonal  5e-5            0.24 %                       −0.25 %    none
+    random     4e-3            0.31 %                       −0.25 %    none
     ========== =============== ============================ ========== ==========
 
-    (−0.25 % is the column's compression, ρgh/2K.) The random packing's second and
-    third layers read the weight of its bumpy surface (particles up to 2.5 R apart
-    in height): ±0.2–0.3 ρgR about the line, their mean on it within 1 %. Martin &
+    (−0.25 % is the column's compression, ρgh/2K.) The discs that close the cells
+    have one radius per body: with 2.5 R_i each (the first version), the random
+    packing's second and third layers read 3–6 % off the line, the surface
+    cells of its small and large particles reaching up unequally. Martin &
     Moyce's dam break on the random packing (K = 2 MPa, μ = 1 Pa·s) keeps the
-    water's area Σ min(A, A0) within 0.07 % to T = 3.35 and, without viscosity, its
-    energy within 2e-5; its front leads their measurements by 4.8–11.8 % (13 %
-    inviscid; the lattices' element water above lags or leads by up to 2 %).
+    water's area Σ min(A, A0) within 0.08 % to T = 3.35 and, without viscosity,
+    its energy within 8e-5; its front leads their measurements by 4.5–12.4 % (9–15 %
+    inviscid; the lattices' element water above keeps within 2 %).
     Tried on the way, not offered: the surface cells at zero pressure with half
     masses (exact on the square lattice; on the hexagonal one the surface row,
     which then resists no compression, drifted, its speed growing from 1e-4 to

@@ -245,6 +245,7 @@ class Continuum:
         its element system in the initial configuration."""
         self.masses = np.full(self.n, np.nan)
         self._cell_a0 = np.full(self.n, np.nan)
+        self._crad = np.zeros(self.n)
         for s, (mat, tol) in enumerate(self.slots):
             if tol is None:
                 continue
@@ -269,7 +270,9 @@ class Continuum:
         from scipy.spatial import cKDTree
         x, r = np.ascontiguousarray(pos[ids], float), np.ascontiguousarray(rad[ids], float)
         tree = cKDTree(x)
-        pairs = tree.query_pairs(2.0 * vcells.REACH * float(r.max()), output_type="ndarray")
+        rc = vcells.REACH * float(r.mean())
+        self._crad[ids] = rc
+        pairs = tree.query_pairs(2.0 * rc, output_type="ndarray")
         cand, cnt = _symmetric_lists(len(r), pairs)
         eq1 = tree.query_pairs(2.0 * float(r.max()) + tol, output_type="ndarray")
         _, ecount = _symmetric_lists(len(r), eq1)
@@ -278,7 +281,7 @@ class Continuum:
         prop = ti.ndarray(ti.types.vector(3, ti.f64), (k,))
         prop.from_numpy(np.column_stack([r, np.zeros(k), np.zeros(k)]))
         area = _cell_run(x, prop, np.zeros(k, np.int32), np.array([[mat.density, 1.0]]),
-                         cand, cnt, self.walls)["area"]
+                         cand, cnt, self.walls, crad=np.full(k, rc))["area"]
         self.masses[ids] = mat.density * area
         self._cell_a0[ids] = area
         self._crit = min(self._crit, float(r.min()) / mat.p_wave_speed)
@@ -290,10 +293,14 @@ class Continuum:
         a["cmat"].from_numpy(np.resize(self.cmat, n) if self.n else np.full(1, -1, np.int32))
         nm = max(len(self.slots), 1)
         tol = np.zeros(nm)
-        rmax = float(np.max(self.a["rad"].to_numpy(), initial=0.0))
-        # the candidates' cut-off R_i + R_j + δ: the two discs' reach, (REACH − 1)·2·max R over
-        tol[:] = 2.0 * (vcells.REACH - 1.0) * rmax
-        self.cell_reach_length = 2.0 * vcells.REACH * rmax
+        rad = np.asarray(self.a["rad"].to_numpy()[:self.n])
+        water = self.cmat[:self.n] >= 0
+        rcmax = float(self._crad[water].max())
+        # the candidates' cut-off R_i + R_j + δ covers the two discs' reach 2 r_c
+        tol[:] = max(2.0 * rcmax - 2.0 * float(rad[water].min()), 0.0)
+        self.cell_reach_length = 2.0 * rcmax
+        a["crad"] = ti.ndarray(ti.f64, (n,))
+        a["crad"].from_numpy(np.resize(self._crad, n) if self.n else np.zeros(1))
         a["cmtol"] = ti.ndarray(ti.f64, (nm,))
         a["cmtol"].from_numpy(tol)
         a["crc"] = ti.ndarray(ti.f64, (n,))
@@ -681,7 +688,7 @@ class Continuum:
             if walls is None:
                 walls = a["cnowall"] = ti.ndarray(ti.f64, (1, 4))
             nw = 0
-        vcells.cells(e["pos"], e["vel"], e["prop"], a["cmat"], a["matp"], a["ccand"],
+        vcells.cells(e["pos"], e["vel"], e["prop"], a["cmat"], a["crad"], a["matp"], a["ccand"],
                      a["cccnt"], walls, nw, a["carea"], a["cpres"], a["cq"], a["cnf"], a["cfj"],
                      a["cfl"], a["cfc"], a["cbnd"], a["cflags"], serial)
         faces = int(launch.host_view(a["cflags"])[0])
@@ -1143,9 +1150,10 @@ def _symmetric_lists(n, pairs):
     return lists, cnt.astype(np.int32)
 
 
-def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls, vel=None):
+def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls, vel=None, crad=None):
     """The cells of particles ``pos`` (one body, candidates ``cand``; ``matp_rows``
-    (ρ0, K, b1) per body, ``vel`` their velocities, default at rest) with the kernel
+    (ρ0, K, b1) per body, ``vel`` their velocities, default at rest; ``crad`` their
+    discs' radii, default REACH × the mean radius) with the kernel
     of the step (the set-up's, before the engine's arrays exist): area, pressure and
     bulk viscosity per particle."""
     from physics.materials import MAT_B1, MAT_RHO
@@ -1157,6 +1165,10 @@ def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls, vel=None):
     A["vel"].from_numpy(np.zeros((n, 2)) if vel is None else np.asarray(vel, float))
     A["cmat"] = ti.ndarray(ti.i32, (n,))
     A["cmat"].from_numpy(cmat)
+    A["crad"] = ti.ndarray(ti.f64, (n,))
+    if crad is None:
+        crad = np.full(n, vcells.REACH * float(np.mean(prop.to_numpy()[:, 0])))
+    A["crad"].from_numpy(np.asarray(crad, float))
     mr = np.atleast_2d(np.asarray(matp_rows, float))
     rows = np.zeros((len(mr), MAT_WIDTH))
     rows[:, MAT_RHO] = mr[:, 0]
@@ -1181,7 +1193,7 @@ def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls, vel=None):
     bnd = _arr(2, (n,))
     flags = ti.ndarray(ti.i32, (1,))
     flags.fill(0)
-    vcells.cells(A["pos"], A["vel"], prop, A["cmat"], A["matp"], A["cand"], A["cnt"],
+    vcells.cells(A["pos"], A["vel"], prop, A["cmat"], A["crad"], A["matp"], A["cand"], A["cnt"],
                  A["wall"], len(walls), out["area"], out["pres"], out["q"], nf, fj, fl, fc,
                  bnd, flags, False)
     return {k: v.to_numpy() for k, v in out.items()}

@@ -9,21 +9,15 @@ at zero pressure and run for 1 s.
 
 The depth of a particle is measured from the water's surface: the level at which
 the cells' area, spread over the tank's width, ends (Σ A_i / W; the cells of the
-surface reach REACH × R above their particles, so this lies about 2.4 R above the
-top particles' centres). That level moves down by ρgh²/2K as the column
+surface reach up to REACH × the mean radius above their particles, so this lies
+about 2.4 R above the top particles' centres). That level moves down by ρgh²/2K as the column
 compresses (0.25 R here), and the pressure follows it: measured from the level
 of the uncompressed cells instead, the top rows read 7 % low.
 
 Checks (after 1 s):
-- the particles in the middle half of the width, above the bottom row: pressure
-  within 2 % of ρ g depth below the top row on the lattices (measured: 0.24 %).
-  On the random packing from 10 R (five mean diameters) below the highest
-  particle's centre (measured: 1.2 %); the layers between read the weight of the
-  bumpy surface above them, whose particles lie up to 2.5 R apart in height: single
-  particles up to ±0.2–0.3 ρgR off the line (5.8 % at 1 s, 3–10 R deep), their
-  mean on it within 1 %. The issue's 2 % for every particle below the
-  top row is met on the lattices, not in the random packing's second and third
-  layers;
+- every particle in the middle half of the width, above the bottom row and below
+  the top row (more than 2.5 R under the highest centre): pressure within 2 % of
+  ρ g depth (measured: 0.24 % on the lattices, 0.31 % on the random packing);
 - every particle slower than 1 % of sqrt(g h);
 - the cells' total area within 0.5 % of the start (it shrinks by the compression,
   ρgh/2K = 0.25 %).
@@ -84,27 +78,19 @@ def test_hydrostatic_pressure_on_any_packing(column):
     x, pr = p["position"], p["pressure"]
     surface = c["area"].sum() / W
     top = x[:, 1].max()
-    below = (x[:, 0] > W / 4) & (x[:, 0] < 3 * W / 4) & (x[:, 1] > 3 * R)
-    err = pr / (RHO * G * (surface - x[:, 1])) - 1.0
-    deep = 2.5 * R if column["kind"] != "random" else 10.0 * R
-    sel = below & (top - x[:, 1] > deep)
+    sel = ((x[:, 0] > W / 4) & (x[:, 0] < 3 * W / 4) & (x[:, 1] > 3 * R)
+           & (top - x[:, 1] > 2.5 * R))
     assert sel.sum() > 300
-    # measured: 0.24 % (square, hexagonal: every row below the top one), 1.2 %
-    # (random, from five mean diameters down)
-    assert np.abs(err[sel]).max() < 0.02
-    if column["kind"] == "random":
-        # the layers between: single particles within 8 % (measured 5.8 %), their
-        # mean within 1 %
-        near = below & (top - x[:, 1] > 2.5 * R) & ~sel
-        assert np.abs(err[near]).max() < 0.08
-        assert abs(err[near].mean()) < 0.01
+    err = pr[sel] / (RHO * G * (surface - x[sel, 1])) - 1.0
+    # measured: 0.24 % (square, hexagonal), 0.31 % (random)
+    assert np.abs(err).max() < 0.02
     # the particles' pressures are what the cells hold (p = K(A0/A − 1))
     assert pr == pytest.approx(c["pressure"], rel=1e-12, abs=1e-9)
 
 
 def test_no_flow_on_any_packing(column):
     v = np.linalg.norm(column["p"]["velocity"], axis=1)
-    # measured: 3e-6 (square), 5e-5 (hexagonal), 6e-3 (random) × sqrt(gh)
+    # measured: 3e-6 (square), 5e-5 (hexagonal), 4e-3 (random) × sqrt(gh)
     assert v.max() < 0.01 * math.sqrt(G * H)
 
 
@@ -133,19 +119,19 @@ def test_dam_break_on_a_random_packing():
     - The water's area, Σ m_i/ρ_i with ρ_i the density of the cell's pressure
       (Σ min(A_i, A0_i): water carries no tension, so a cell that has grown beyond
       its area at rest holds no more water), kept within 1 % up to T = t·sqrt(2g/a)
-      = 3 (measured: within 0.07 %).
+      = 3 (measured: within 0.08 %).
     - No energy made: kinetic + gravitational + the cells' stored energy + the
       walls' springs never above its start.
     - The surge front (the largest x + R) against Martin & Moyce's measured x/a:
-      measured +8.7, +11.8, +10.1, +8.4, +4.8 % at T = 0.83, 1.22, 2.0, 2.55, 3.35
-      (without the viscosity +9.7, +13.0, +11.2, +9.3, +6.3 %; a first version of
+      measured +9.4, +12.4, +10.0, +7.9, +4.5 % at T = 0.83, 1.22, 2.0, 2.55, 3.35
+      (without the viscosity +10.3, +14.6, +12.8, +11.3, +9.0 %; a first version of
       the model gave the same within 1 % at R = 10 mm and with K = ρ(10·sqrt(2gh))²,
       so the lead is not the resolution's). The issue's 10 % is missed at T = 1.22
-      and 2.0; the front leads the measurements at every time, as inviscid models
-      of the experiment do (its gate took a finite time to lift).
+      (and just reached at T = 2.0); the front leads the measurements at every time,
+      as inviscid models of the experiment do (its gate took a finite time to lift).
 
     Without the viscosity the energy is kept: kinetic + gravitational + stored within
-    2e-5 of its start to T = 3.35 (test_inviscid_cells_keep_the_energy)."""
+    8e-5 of its start to T = 3.35 (test_inviscid_cells_keep_the_energy)."""
     a = 0.3
     h = math.sqrt(2.0) * a
     water = tdem.Fluid(density=RHO, bulk_modulus=2e6, viscosity=1.0, voronoi=True)
@@ -171,15 +157,15 @@ def test_dam_break_on_a_random_packing():
     assert max(energies) <= start + 1e-6 * abs(start)
     lead = [f / z - 1.0 for f, (_, z) in zip(fronts, measured) if z is not None]
     assert min(lead) > 0.0                # ahead of the measurements at every time
-    assert max(lead) < 0.13
+    assert max(lead) < 0.14
 
 
 def test_inviscid_cells_keep_the_energy():
     """The cells' forces are the gradient of their stored energy Σ A0 K (V − 1 − ln V)
     (physics.pcmm.cells): a small dam break with no viscosity and no damping keeps
-    kinetic + gravitational + stored energy (and the walls' springs) within 3e-4 of
-    its start while the column collapses (measured 9e-5; on the full column of
-    test_dam_break_on_a_random_packing 2e-5), although the cells' neighbours change
+    kinetic + gravitational + stored energy (and the walls' springs) within 5e-4 of
+    its start while the column collapses (on the full column of
+    test_dam_break_on_a_random_packing: 8e-5), although the cells' neighbours change
     all the time."""
     a = 0.1
     water = tdem.Fluid(density=RHO, bulk_modulus=1e6, voronoi=True)
@@ -198,9 +184,9 @@ def test_inviscid_cells_keep_the_energy():
     # the column is collapsing: a tenth of its potential energy above the floor is
     # kinetic
     assert sim.energy()["kinetic"] > 0.1 * e0["gravitational"]
-    # measured: 1e-7, 1.2e-5, 9e-5 of it at T = 1, 2, 3 (kinetic then 0.65 of the
+    # measured: 5e-6, 6e-5, 1.5e-4 of it at T = 1, 2, 3 (kinetic then 0.64 of the
     # potential energy above the floor)
-    assert max(abs(d) for d in drift) < 3e-4 * start
+    assert max(abs(d) for d in drift) < 5e-4 * start
 
 
 def test_voronoi_water_restarts_bitwise(tmp_path):
@@ -249,7 +235,7 @@ def test_cell_areas_and_their_rate():
     rho, k, b1 = RHO, 1e6, 0.5
     base = _cell_run(pos, prop, cm, [[rho, k, b1]], cand, cnt, walls)
     # disjoint cells covering the box, less the corners of the few cells that reach
-    # their disc (the packing's widest pores): measured 3.8e-4 of it
+    # their disc (the packing's widest pores): measured 6.6e-4 of it
     assert side * side * (1 - 1e-3) < base["area"].sum() <= side * side * (1 + 1e-12)
     vel = rng.normal(size=(n, 2))
     got = _cell_run(pos, prop, cm, [[rho, k, b1]], cand, cnt, walls, vel=vel)

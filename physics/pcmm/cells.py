@@ -3,8 +3,10 @@
 
 The particles of such a body make no elements. Each one owns the part of the plane
 nearer to it than to any other particle of its body (its Voronoi cell), cut off by
-the tank's walls and by a disc of radius ``REACH`` × R_i about its centre (which
-closes the cells of the free surface). With A_i the cell's area and A0_i = m_i/ρ0
+the tank's walls and by a disc of radius r_c = ``REACH`` × the mean radius of the
+body's particles about its centre (which closes the cells of the free surface; one
+radius for the whole body, so that in a polydisperse packing the small particles'
+cells close the pores between the large ones as well). With A_i the cell's area and A0_i = m_i/ρ0
 its area at zero pressure (the cells of the initial packing: the masses are ρ0 A0),
 
     p_i = K · max(A0_i/A_i − 1, 0),
@@ -40,7 +42,7 @@ law (:func:`physics.pcmm.nodal.gather` marks their pair slots and adds the
 :func:`fluid_core_force`).
 
 Cost: a cell is a polygon of at most MAX_VERTS vertices clipped by the bisector of
-each candidate (same-body particles nearer than (REACH + 1)·(R_i + R_j) + skin, found
+each candidate (same-body particles nearer than 2 r_c + skin, found
 by :func:`physics.pcmm.candidates` with its own flags); its faces (at most
 MAX_FACES) are kept for the force pass, which reads the faces of the neighbours
 (no atomics, a fixed order).
@@ -50,11 +52,11 @@ import math
 import taichi as ti
 
 from tdem.launch import cached
-from tdem.state import PROP_MASS, PROP_RADIUS
+from tdem.state import PROP_MASS
 
 from ..materials import MAT_B1, MAT_B2, MAT_K, MAT_RHO, MAT_VISC
 
-REACH = 2.5        # the bounding disc's radius, in particle radii
+REACH = 2.5        # the bounding disc's radius, in mean particle radii of the body
 SIDES = 24         # the bounding disc as a regular polygon
 MAX_VERTS = 48
 MAX_FACES = 24
@@ -105,7 +107,7 @@ def _clip(px: ti.template(), py: ti.template(), lab: ti.template(), nv, a, b, la
 @cached
 @ti.kernel
 def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarray(),
-          cmat: ti.types.ndarray(),
+          cmat: ti.types.ndarray(), crad: ti.types.ndarray(),
           matp: ti.types.ndarray(), cand: ti.types.ndarray(), ccnt: ti.types.ndarray(),
           wall: ti.types.ndarray(), nwalls: ti.i32, carea: ti.types.ndarray(),
           cpres: ti.types.ndarray(), cq: ti.types.ndarray(), cnf: ti.types.ndarray(),
@@ -114,7 +116,8 @@ def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarr
           cflags: ti.types.ndarray(), serial: ti.template()):
     """Each cell particle's cell: its area (``carea``), pressure (``cpres``), faces
     (``cnf`` of them: neighbour ``cfj``, length ``cfl``, midpoint ``cfc``) and Σ l n
-    over its arcs (``cbnd``). ``cflags[0]``: the largest face count met (a cell
+    over its arcs (``cbnd``); ``crad``: each particle's r_c. ``cflags[0]``: the
+    largest face count met (a cell
     with more faces than MAX_FACES is an error the host raises).
 
     ``cq``: the artificial bulk viscosity of a shrinking cell, q = ρ L r (b1 c + b2
@@ -126,7 +129,7 @@ def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarr
         M = cmat[i]
         if M >= 0:
             xi = pos[i]
-            rc = REACH * prop[i][PROP_RADIUS]
+            rc = crad[i]
             px = ti.Vector([0.0] * MAX_VERTS)
             py = ti.Vector([0.0] * MAX_VERTS)
             lab = ti.Vector([0] * MAX_VERTS, dt=ti.i32)
@@ -153,7 +156,7 @@ def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarr
             for q in range(ccnt[i]):
                 j = cand[i, q]
                 d = pos[j] - xi
-                if d.norm() < rc + REACH * prop[j][PROP_RADIUS]:
+                if d.norm() < rc + crad[j]:
                     nv = _clip(px, py, lab, nv, d, d.dot(xi + 0.5 * d), j)
             area = 0.0
             bnd = ti.Vector([0.0, 0.0])
