@@ -55,10 +55,10 @@ Presets
 - ``--water cells`` (either preset): the water packed at random as the paper's
   is, as Voronoi cells (``tdem.Fluid(voronoi=True)``, ``physics.pcmm.cells``),
   which hold at rest and keep their area as they flow on any packing. Quick:
-  R = 1.4-2.6 cm, 660 discs at 76 % of the column (160 s, 7 of 10 checks,
+  R = 1.4-2.6 cm, 660 discs at 76 % of the column (192 s, 8 of 10 checks,
   docs/cases.md); paper: the paper's 5528 discs of R = 3-8 mm (50 % of the
-  column; the cells of the smallest discs, closed at 2.5 R, leave the widest
-  pores empty: they cover 1.06 of the column's 1.12 m²; not run).
+  column; its widest pores stay empty: the cells cover 1.09 of the column's
+  1.12 m²; not run).
 
 Outcome measure. "Stood", "slid" or "toppled" is decided from the top block of
 the rightmost column (largest values over the run): toppled if its rotation
