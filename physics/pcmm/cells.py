@@ -6,8 +6,9 @@ nearer to it than to any other particle of its body (its Voronoi cell), cut off 
 the tank's walls and by a disc of radius r_c = ``REACH`` × the mean radius of the
 body's particles about its centre (which closes the cells of the free surface; one
 radius for the whole body, so that in a polydisperse packing the small particles'
-cells close the pores between the large ones as well). With A_i the cell's area and A0_i = m_i/ρ0
-its area at zero pressure (the cells of the initial packing: the masses are ρ0 A0),
+cells close the pores between the large ones as well). With A_i the cell's area
+and A0_i = m_i/ρ0 its area at zero pressure (the cells of the initial packing: the
+masses are ρ0 A0),
 
     p_i = K · max(A0_i/A_i − 1, 0),
 
@@ -31,13 +32,16 @@ the distance of the centres, and the last sum over the edges of the bounding dis
 - the cells and their areas change continuously as particles move past each
   other (a face appears or goes with zero length), so nothing jumps when the
   neighbourhood of a particle changes, as element deletion and creation do;
-- momentum is kept: the energy does not change when every particle moves alike.
+- momentum is kept: the energy does not change when every particle moves alike
+  (where walls cut the cells, the sum of the forces is the push the walls' faces
+  would take, and the walls give it back through the contact law).
 
 The walls (the engine's segment walls, within the disc's reach) cut the cells and
 carry no derivative: the particles are held off them by the contact law, which
 takes the pressure the wall receives. A viscosity μ adds the force
 μ Σ_j (l_ij/d_ij)(v_j − v_i) (the Voronoi Laplacian of the velocity; pairwise,
-momentum-conserving, dissipative). Same-body neighbours meet through no contact
+momentum-conserving, dissipative), and a shrinking cell the artificial bulk
+viscosity of the elements (:func:`cells`). Same-body neighbours meet through no contact
 law (:func:`physics.pcmm.nodal.gather` marks their pair slots and adds the
 :func:`fluid_core_force`).
 
