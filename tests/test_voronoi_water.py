@@ -127,8 +127,9 @@ def test_dam_break_on_a_random_packing():
       (without the viscosity +10.3, +14.6, +12.8, +11.3, +9.0 %; a first version of
       the model gave the same within 1 % at R = 10 mm and with K = ρ(10·sqrt(2gh))²,
       so the lead is not the resolution's). The issue's 10 % is missed at T = 1.22
-      (and just reached at T = 2.0); the front leads the measurements at every time,
-      as inviscid models of the experiment do (its gate took a finite time to lift).
+      (and just reached at T = 2.0); the front leads the measurements at every time
+      (here the column is released at once on a frictionless floor; the
+      experiment's column stood behind a barrier that took time to remove).
 
     Without the viscosity the energy is kept: kinetic + gravitational + stored within
     8e-5 of its start to T = 3.35 (test_inviscid_cells_keep_the_energy)."""
