@@ -128,8 +128,7 @@ def test_dam_break_on_a_random_packing():
       the model gave the same within 1 % at R = 10 mm and with K = ρ(10·sqrt(2gh))²,
       so the lead is not the resolution's). The issue's 10 % is missed at T = 1.22
       (and just reached at T = 2.0); the front leads the measurements at every time
-      (here the column is released at once on a frictionless floor; the
-      experiment's column stood behind a barrier that took time to remove).
+      (here the column is released at once, on a frictionless floor).
 
     Without the viscosity the energy is kept: kinetic + gravitational + stored within
     8e-5 of its start to T = 3.35 (test_inviscid_cells_keep_the_energy)."""
