@@ -25,10 +25,11 @@ import taichi as ti
 from coupling import point_edge as pe
 from physics import blocks as blk
 from physics import pcmm
-from physics.materials import JWL, JWL_TYPE, MAT_G, MAT_K, MAT_TYPE, MAT_WIDTH, Fluid
+from physics.materials import (JWL, JWL_TYPE, MAT_G, MAT_K, MAT_RHO, MAT_TYPE, MAT_WIDTH,
+                               Fluid)
 from physics.pcmm import cells as vcells
 
-from . import backend, launch
+from . import backend
 from .errors import CapacityError, InputError
 from .launch import cached
 from .mesh import nodal_masses
@@ -118,6 +119,7 @@ class Continuum:
         cslots = [s for s, (m, _) in enumerate(slots) if isinstance(m, Fluid) and m.voronoi]
         self.cmat = np.where(np.isin(pmat, cslots), pmat, -1).astype(np.int32)
         self.has_cells = bool((self.cmat >= 0).any())
+        self._cells_need = 0
         # the longest Eq. 1 cut-off, 2·max R + max δ (the candidate search's reach)
         self.reach_length = 2.0 * float(np.max(rad, initial=0.0)) + max(
             (t for _, t in slots if t is not None), default=0.0)
@@ -244,7 +246,6 @@ class Continuum:
         """Eq. 5 masses and the shortest element altitude of each PCMM body, from
         its element system in the initial configuration."""
         self.masses = np.full(self.n, np.nan)
-        self._cell_a0 = np.full(self.n, np.nan)
         self._crad = np.zeros(self.n)
         for s, (mat, tol) in enumerate(self.slots):
             if tol is None:
@@ -280,10 +281,11 @@ class Continuum:
         k = len(r)
         prop = ti.ndarray(ti.types.vector(3, ti.f64), (k,))
         prop.from_numpy(np.column_stack([r, np.zeros(k), np.zeros(k)]))
-        area = _cell_run(x, prop, np.zeros(k, np.int32), np.array([[mat.density, 1.0]]),
-                         cand, cnt, self.walls, crad=np.full(k, rc))["area"]
+        cells = _cell_run(x, prop, np.zeros(k, np.int32), np.array([[mat.density, 1.0]]),
+                          cand, cnt, self.walls, crad=np.full(k, rc))
+        _check_faces(cells["faces"])
+        area = cells["area"]
         self.masses[ids] = mat.density * area
-        self._cell_a0[ids] = area
         self._crit = min(self._crit, float(r.min()) / mat.p_wave_speed)
 
     def _alloc_cells(self):
@@ -668,19 +670,12 @@ class Continuum:
             return
         a, e = self.a, sim._a
         serial = sim._serial()
-        while True:
-            pcmm.candidates(e["pos"], a["rad"], a["crc"], a["crmax"], a["cmat"], a["cmtol"],
-                            a["ccand"], a["cccnt"], e["cell_count"], e["cell_start"],
-                            e["sorted"], e["gridp"], e["gridn"], e["flags"], a["cpflags"],
-                            F_BUILDS, float(sim.skin), int(reach))
-            need = int(launch.host_view(a["cpflags"])[pcmm.P_NEED])
-            cap = a["ccand"].shape[1]
-            if need <= cap:
-                break
-            if need > MAX_CANDIDATES:
-                raise CapacityError(f"a water particle has {need} cell candidates, more than "
-                                    f"{MAX_CANDIDATES}: are its radii far apart?")
-            self._cells_cap(1 << int(need).bit_length())
+        # (a particle with more candidates than slots keeps the first ones; status()
+        # finds it at the end of the run segment, which is then run again with more)
+        pcmm.candidates(e["pos"], a["rad"], a["crc"], a["crmax"], a["cmat"], a["cmtol"],
+                        a["ccand"], a["cccnt"], e["cell_count"], e["cell_start"],
+                        e["sorted"], e["gridp"], e["gridn"], e["flags"], a["cpflags"],
+                        F_BUILDS, float(sim.skin), int(reach))
         walls = e.get("wall")
         nw = len(sim._walls_host)
         if walls is None or nw == 0:
@@ -691,11 +686,6 @@ class Continuum:
         vcells.cells(e["pos"], e["vel"], e["prop"], a["cmat"], a["crad"], a["matp"], a["ccand"],
                      a["cccnt"], walls, nw, a["carea"], a["cpres"], a["cq"], a["cnf"], a["cfj"],
                      a["cfl"], a["cfc"], a["cbnd"], a["cflags"], serial)
-        faces = int(launch.host_view(a["cflags"])[0])
-        if faces > vcells.MAX_FACES:
-            raise CapacityError(f"a water particle's Voronoi cell has {faces} faces, more than "
-                                f"{vcells.MAX_FACES}: are its neighbours' radii far smaller "
-                                "than its own?")
         vcells.cell_forces(e["pos"], e["vel"], a["cmat"], a["matp"], a["ccand"], a["cccnt"],
                            a["cpres"], a["cq"], a["cnf"], a["cfj"], a["cfl"], a["cfc"],
                            a["cbnd"], a["xforce"], a["psig"], serial)
@@ -826,20 +816,38 @@ class Continuum:
                                 f"more than {pcmm.MAX_INCIDENT}: is the tolerance far larger "
                                 "than the radii?")
         need = int(flags[pcmm.P_NEED]) if self.has_pcmm else 0
+        if self.has_cells:
+            self._cells_need = int(self.a["cpflags"].to_numpy()[pcmm.P_NEED])
+            _check_faces(int(self.a["cflags"].to_numpy()[0]))
         bad = -1
         if self.nv:
             b = int(self.a["nflags"].to_numpy()[0])
             bad = b if b < self.nv else -1
         return need, bad
 
+    def short(self, need):
+        """Whether the last run segment lacked candidate slots: PCMM's (``need``, from
+        :meth:`status`) or the water cells'."""
+        return need > self.capacity or (
+            self.has_cells and self._cells_need > self.a["ccand"].shape[1])
+
     def grow(self, need):
-        new = 1 << int(need).bit_length()
-        if new > MAX_CANDIDATES:
-            raise CapacityError(f"a PCMM particle has {need} Eq. 1 candidates, more than "
-                                f"{MAX_CANDIDATES}: is the tolerance far larger than the radii?")
-        self.capacity = new
-        self._alloc_lists()
-        self.snap.pop("cand", None)
+        """More candidate slots where :meth:`short` found too few (the segment is run
+        again)."""
+        if need > self.capacity:
+            new = 1 << int(need).bit_length()
+            if new > MAX_CANDIDATES:
+                raise CapacityError(f"a PCMM particle has {need} Eq. 1 candidates, more than "
+                                    f"{MAX_CANDIDATES}: is the tolerance far larger than the "
+                                    "radii?")
+            self.capacity = new
+            self._alloc_lists()
+            self.snap.pop("cand", None)
+        if self.has_cells and self._cells_need > self.a["ccand"].shape[1]:
+            if self._cells_need > MAX_CANDIDATES:
+                raise CapacityError(f"a water particle has {self._cells_need} cell candidates, "
+                                    f"more than {MAX_CANDIDATES}: are its radii far apart?")
+            self._cells_cap(1 << int(self._cells_need).bit_length())
 
     def sync_copies(self):
         """Bring every slot's element stress (``esig``) up to date from the last stress
@@ -964,7 +972,7 @@ class Continuum:
             c = self.cell_state()
             sel = np.flatnonzero(c["cmat"] >= 0)
             if len(sel):
-                a0 = self._cell_a0[sel]
+                a0 = self.masses[sel] / rows[c["cmat"][sel], MAT_RHO]
                 v = c["area"][sel] / a0
                 k = rows[c["cmat"][sel], MAT_K]
                 total += float(np.sum(np.where(v < 1.0, a0 * k * (v - 1.0 - np.log(
@@ -1156,7 +1164,7 @@ def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls, vel=None, crad=None)
     discs' radii, default REACH × the mean radius) with the kernel
     of the step (the set-up's, before the engine's arrays exist): area, pressure and
     bulk viscosity per particle."""
-    from physics.materials import MAT_B1, MAT_RHO
+    from physics.materials import MAT_B1
     n = len(pos)
     A = {}
     A["pos"] = _arr(2, (n,))
@@ -1196,4 +1204,12 @@ def _cell_run(pos, prop, cmat, matp_rows, cand, cnt, walls, vel=None, crad=None)
     vcells.cells(A["pos"], A["vel"], prop, A["cmat"], A["crad"], A["matp"], A["cand"], A["cnt"],
                  A["wall"], len(walls), out["area"], out["pres"], out["q"], nf, fj, fl, fc,
                  bnd, flags, False)
-    return {k: v.to_numpy() for k, v in out.items()}
+    return {**{k: v.to_numpy() for k, v in out.items()}, "faces": int(flags.to_numpy()[0])}
+
+
+def _check_faces(faces):
+    """A Voronoi cell with more faces than its slots hold is an error."""
+    if faces > vcells.MAX_FACES:
+        raise CapacityError(f"a water particle's Voronoi cell has {faces} faces, more than "
+                            f"{vcells.MAX_FACES}: are its neighbours' radii far smaller than "
+                            "its own?")

@@ -821,7 +821,7 @@ class Runner:
         flags = self._status()
         if self._cont is not None:
             need, bad = self._cont.status()
-            if need > self._cont.capacity:
+            if self._cont.short(need):
                 self._restore_snapshot()
                 self._cont.grow(need)
                 return

@@ -249,3 +249,29 @@ def test_cell_areas_and_their_rate():
     back = -got["q"][shrink] * a / (rho * np.sqrt(a) * b1 * np.sqrt(k / rho))
     assert back == pytest.approx(rate[shrink], rel=1e-6, abs=1e-9 * np.abs(rate).max())
     assert np.all(rate[~shrink] >= -1e-9 * np.abs(rate).max())
+
+
+def test_too_few_cell_candidate_slots_are_grown_and_the_segment_run_again():
+    """A particle with more cell candidates than slots keeps the first ones; the end
+    of the run segment finds it, gives the cells more slots and runs the segment
+    again: the run is the same to the bit as one that had the slots from the start."""
+    def column():
+        water = tdem.Fluid(density=RHO, bulk_modulus=1e6, viscosity=1.0, voronoi=True)
+        sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5, progress=False)
+        pos, r = packing("random", 0.1, 0.1, R)
+        sim.add_particles(pos, r, material=water, tolerance=R)
+        tank(sim, 0.3, 1.0, 1e6)
+        sim.run(steps=1)
+        return sim
+    a, b = column(), column()
+    cap = a._cont.a["ccand"].shape[1]
+    b._cont._cells_cap(4)
+    a.run(steps=200)
+    b.run(steps=200)
+    assert b._cont.a["ccand"].shape[1] >= 16 > 4
+    assert int(b._cont.a["cccnt"].to_numpy().max()) > 4
+    assert a._cont.a["ccand"].shape[1] == cap
+    pa, pb = a.particles.numpy(), b.particles.numpy()
+    assert float(np.abs(pa["velocity"]).max()) > 0.01
+    for key in ("position", "velocity", "pressure"):
+        assert np.array_equal(pa[key], pb[key]), key

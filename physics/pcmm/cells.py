@@ -58,7 +58,8 @@ import taichi as ti
 from tdem.launch import cached
 from tdem.state import PROP_MASS
 
-from ..materials import MAT_B1, MAT_B2, MAT_K, MAT_RHO, MAT_VISC
+from ..materials import MAT_K, MAT_RHO, MAT_VISC
+from .stress import bulk_viscosity
 
 REACH = 2.5        # the bounding disc's radius, in mean particle radii of the body
 SIDES = 24         # the bounding disc as a regular polygon
@@ -121,8 +122,8 @@ def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarr
     """Each cell particle's cell: its area (``carea``), pressure (``cpres``), faces
     (``cnf`` of them: neighbour ``cfj``, length ``cfl``, midpoint ``cfc``) and Σ l n
     over its arcs (``cbnd``); ``crad``: each particle's r_c. ``cflags[0]``: the
-    largest face count met (a cell
-    with more faces than MAX_FACES is an error the host raises).
+    largest face count met (a cell with more faces than MAX_FACES is an error the
+    host raises at the end of the run segment).
 
     ``cq``: the artificial bulk viscosity of a shrinking cell, q = ρ L r (b1 c + b2
     L r) with r = −(dA/dt)/A, L = sqrt(A) (the elements' form,
@@ -192,13 +193,10 @@ def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarr
             rho = matp[M, MAT_RHO]
             a0 = prop[i][PROP_MASS] / rho
             cpres[i] = matp[M, MAT_K] * ti.max(a0 / area - 1.0, 0.0) if area > 0.0 else 0.0
-            q = 0.0
-            b1 = matp[M, MAT_B1]
-            b2 = matp[M, MAT_B2]
-            if rate < 0.0 and b1 + b2 > 0.0 and area > 0.0:
-                L = ti.sqrt(area)
-                r = -rate / area
-                q = rho * L * r * (b1 * ti.sqrt(matp[M, MAT_K] / rho) + b2 * L * r)
+            # the elements' form, with the cell's relative area change over the
+            # step for their volumetric strain increment (per unit time here)
+            q = bulk_viscosity(matp, M, ti.Vector([rate / area if area > 0.0 else 0.0,
+                                                   0.0, 0.0]), 1.0, area)
             cq[i] = q
 
 
@@ -212,10 +210,11 @@ def cell_forces(pos: ti.types.ndarray(), vel: ti.types.ndarray(), cmat: ti.types
                 xforce: ti.types.ndarray(), psig: ti.types.ndarray(), serial: ti.template()):
     """F_i = p_i ∂A_i/∂x_i + Σ_j p_j ∂A_j/∂x_i (the module docstring) plus the
     viscous force, added to ``xforce``, with p + q for p (``cq``, the bulk
-    viscosity); the particle's stress (−p, −p, 0, −p) into ``psig``. The second sum runs over i's candidates and reads each one's own face
-    with i (the two discs can cut a face differently, or away from one cell); the
-    viscosity takes the mean of the two cells' lengths of a face, so that it is
-    the same for both particles."""
+    viscosity); the particle's stress (−p, −p, 0, −p) into ``psig``. The second
+    sum runs over i's candidates and reads each one's own face with i (the two
+    discs can cut a face differently, or away from one cell); the viscosity takes
+    the mean of the two cells' lengths of a face, so that it is the same for both
+    particles."""
     ti.loop_config(serialize=serial)
     for i in range(cmat.shape[0]):
         M = cmat[i]
