@@ -627,6 +627,10 @@ def _extra(p):
                         "cells: water of Voronoi cells (tdem.Fluid(voronoi=True)) packed at "
                         "random, R = 1.4-2.6 cm (quick) or the paper's 5528 discs of 3-8 mm "
                         "(paper)")
+    p.add_argument("--runs", nargs="+", choices=("four", "two"), default=("four", "two"),
+                   help="which block systems to run (default both, one after the other)")
+    p.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="seconds after the board's removal (default: the preset's)")
     p.add_argument("--sweep", action="store_true",
                    help="four columns over the parameters the paper does not give (floor "
                         "and block friction, column gap; cases.water_blocks.SWEEP) at the "
@@ -665,7 +669,11 @@ def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
     if args.sweep:
         return main_sweep(args, out)
-    s = run(args.preset, out, arch=args.arch, threads=args.threads, water=args.water)
+    if args.duration is not None and not args.duration > 0.0:
+        from tdem.errors import InputError
+        raise InputError(f"duration must be > 0, got {args.duration!r}")
+    s = run(args.preset, out, arch=args.arch, threads=args.threads, water=args.water,
+            duration=args.duration, runs=tuple(dict.fromkeys(args.runs)))
     common.print_checks(s)
     print(f"summary: {out / 'summary.json'}")
     return 0

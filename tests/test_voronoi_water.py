@@ -112,28 +112,30 @@ def test_voronoi_water_input_is_checked():
 
 
 def test_dam_break_on_a_random_packing():
-    """Martin & Moyce's column (h = sqrt(2)·a, a = 0.3 m; tests/test_fluid.py) packed
+    """Martin & Moyce's column (h = 2a, a = 0.3 m; tests/test_fluid.py) packed
     at random (R = 5 mm, radii 0.8–1.2 R, 76 % of the area), K = 2 MPa, μ = 1 Pa·s,
     released at rest in a 1.5 m tank, no damping.
 
     - The water's area, Σ m_i/ρ_i with ρ_i the density of the cell's pressure
       (Σ min(A_i, A0_i): water carries no tension, so a cell that has grown beyond
       its area at rest holds no more water), kept within 1 % up to T = t·sqrt(2g/a)
-      = 3 (measured: within 0.08 %).
+      = 3 (measured: within 0.11 %).
     - No energy made: kinetic + gravitational + the cells' stored energy + the
       walls' springs never above its start.
     - The surge front (the largest x + R) against Martin & Moyce's measured x/a:
-      measured +9.4, +12.4, +10.0, +7.9, +4.5 % at T = 0.83, 1.22, 2.0, 2.55, 3.35
-      (without the viscosity +10.3, +14.6, +12.8, +11.3, +9.0 %; a first version of
-      the model gave the same within 1 % at R = 10 mm and with K = ρ(10·sqrt(2gh))²,
-      so the lead is not the resolution's). The issue's 10 % is missed at T = 1.22
-      (and just reached at T = 2.0); the front leads the measurements at every time
-      (here the column is released at once, on a frictionless floor).
+      ahead of it at every time, by less than 20 %: measured +12.4, +17.0, +14.0,
+      +12.2, +10.2 % at T = 0.83, 1.22, 2.0, 2.55, 3.35 (without the viscosity
+      +14.7, +19.1, +14.5, +12.4, +10.8 %; with R = 7.5 mm +9.5, +14.9, +12.8,
+      +12.1, +9.5 %: the finer packing runs further ahead, its leading tongue one
+      or two particles thick along the frictionless floor). 10 % at every time
+      is missed. (An earlier version of this test used a column of h = sqrt(2)·a,
+      reading their n² = 2 as n = h/a; that lower column led by +9.4 to +12.4 %.)
 
     Without the viscosity the energy is kept: kinetic + gravitational + stored within
-    8e-5 of its start to T = 3.35 (test_inviscid_cells_keep_the_energy)."""
+    2e-5 of its start to T = 3.35, when 0.71 of it is kinetic
+    (test_inviscid_cells_keep_the_energy)."""
     a = 0.3
-    h = math.sqrt(2.0) * a
+    h = 2.0 * a
     water = tdem.Fluid(density=RHO, bulk_modulus=2e6, viscosity=1.0, voronoi=True)
     sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5)
     pos, r = packing("random", a, h, R)
@@ -157,7 +159,7 @@ def test_dam_break_on_a_random_packing():
     assert max(energies) <= start + 1e-6 * abs(start)
     lead = [f / z - 1.0 for f, (_, z) in zip(fronts, measured) if z is not None]
     assert min(lead) > 0.0                # ahead of the measurements at every time
-    assert max(lead) < 0.14
+    assert max(lead) < 0.20
 
 
 def test_inviscid_cells_keep_the_energy():
@@ -165,7 +167,7 @@ def test_inviscid_cells_keep_the_energy():
     (physics.pcmm.cells): a small dam break with no viscosity and no damping keeps
     kinetic + gravitational + stored energy (and the walls' springs) within 5e-4 of
     its start while the column collapses (on the full column of
-    test_dam_break_on_a_random_packing: 8e-5), although the cells' neighbours change
+    test_dam_break_on_a_random_packing: 2e-5), although the cells' neighbours change
     all the time."""
     a = 0.1
     water = tdem.Fluid(density=RHO, bulk_modulus=1e6, voronoi=True)
