@@ -380,6 +380,8 @@ def run_one(cfg, columns, name, out, arch=None, threads=None, folder=None):
            "outside": []}
     snaps = []
     status = "completed"
+    clock = common.Stopwatch()
+    said = 0.0
     for tc in stops:
         try:
             sim.run(until=t0 + tc)
@@ -400,6 +402,13 @@ def run_one(cfg, columns, name, out, arch=None, threads=None, folder=None):
         speed = np.linalg.norm(p["velocity"][ids], axis=1)
         rec["vmax_water"].append(float(speed[inside].max()) if inside.any() else 0.0)
         rec["outside"].append(int(np.count_nonzero(~inside)))
+        if tc >= said + 0.1 - 1e-9 or tc >= T - 1e-9:     # a line every 0.1 s of the run
+            said = tc
+            el = clock()
+            common.say(f"{name}: t = {tc:.2f} of {T:g} s, top block dx = "
+                       f"{rec['dx_top'][-1]:+.3f} m, rotation {rec['rot_top'][-1]:+.1f} deg; "
+                       f"{common.duration(el)} so far, about "
+                       f"{common.duration(el * (T - tc) / tc)} left")
         if any(abs(tc - s) < 1e-6 for s in snap_t):
             k = snap_t.index(min(snap_t, key=lambda s: abs(s - tc)))
             at_paper = k < len(paper_t) and abs(snap_t[k] - paper_t[k]) < 1e-6

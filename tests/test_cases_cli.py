@@ -83,3 +83,13 @@ def test_nine_disc_quick(tmp_path):
         assert (out / png).stat().st_size > 0
     assert (out / "histories.h5").exists()
     assert list(out.glob("*.pvd"))
+
+
+def test_water_blocks_duration_is_checked(tmp_path):
+    """water_blocks --duration must be a positive time: refused, naming it, before
+    anything is built or written."""
+    from cases import water_blocks
+    from tdem.errors import InputError
+    with pytest.raises(InputError, match="duration"):
+        water_blocks.main(["--duration", "0", "--out", str(tmp_path / "wb")])
+    assert not (tmp_path / "wb" / "summary.json").exists()
