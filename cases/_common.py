@@ -207,9 +207,13 @@ def overall_pass(checks):
     return all(compared) if compared else None
 
 
-def summary(case, preset, checks, data, wall_time_s, threads=None, paper=None, notes=None):
+def summary(case, preset, checks, data, wall_time_s, threads=None, paper=None, notes=None,
+            variant=None):
     """The summary of one run (docs/cases.md, "summary.json"): the checks, the overall
-    pass, what ran and how long, and the case's own data under ``data``."""
+    pass, what ran and how long, and the case's own data under ``data``. ``variant``:
+    a name for a run that is not the preset as it stands (e.g. "cells-four": other
+    water, one of its two systems); the validation report keeps it beside the
+    preset's own run."""
     names = [c["name"] for c in checks]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
@@ -231,6 +235,8 @@ def summary(case, preset, checks, data, wall_time_s, threads=None, paper=None, n
         out["paper"] = paper
     if notes:
         out["notes"] = notes
+    if variant:
+        out["variant"] = str(variant)
     out["data"] = data
     return _plain(out)
 

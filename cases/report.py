@@ -141,7 +141,8 @@ def render_check(c):
 def render_checks(s):
     """The table of every check of one summary."""
     n = s["counts"]
-    lines = [f"`{s['case']}`, {s['preset']} preset ({common.duration(s['wall_time_s'])}, "
+    which = f"{s['preset']} preset" + (f" ({s['variant']})" if s.get("variant") else "")
+    lines = [f"`{s['case']}`, {which} ({common.duration(s['wall_time_s'])}, "
              f"{how_measured([s])}): {n['passed']} of {n['passed'] + n['failed']} compared "
              f"checks pass, {n['reported']} reported only (no tolerance). "
              "Tolerances and why: the notes in `summary.json`.",
@@ -232,7 +233,7 @@ def archive(run_dir, root=VALIDATION):
     if bad:
         raise ValueError(f"--archive {run_dir}: its summary.json does not follow the "
                          f"schema: {'; '.join(bad)}")
-    dest = Path(root) / s["case"] / s["preset"]
+    dest = Path(root) / s["case"] / folder_name(s)
     if dest.exists():
         shutil.rmtree(dest)
     dest.mkdir(parents=True)
@@ -242,23 +243,38 @@ def archive(run_dir, root=VALIDATION):
     return dest
 
 
+def folder_name(s):
+    """Where a run is kept under its case: PRESET, or PRESET-VARIANT for a variant."""
+    return s["preset"] + (f"-{s['variant']}" if s.get("variant") else "")
+
+
+def label(s):
+    """The preset column of a kept run: 'paper', or 'paper, cells-four' for a variant."""
+    return s["preset"] + (f", {s['variant']}" if s.get("variant") else "")
+
+
 def kept(root=VALIDATION):
-    """[(case, preset, summary, plot names)] of the kept runs, in table order."""
+    """[(case, folder, summary, plot names)] of the kept runs, in table order: each
+    preset's own run, then its variants (folders PRESET-VARIANT) by name."""
     out = []
     root = Path(root)
     for case in cases():
         for preset in PRESET_ORDER:
-            path = root / case / preset / "summary.json"
-            if path.exists():
-                s = json.loads(path.read_text())
-                plots = sorted(p.name for p in path.parent.glob("*.png"))
-                out.append((case, preset, s, plots))
+            here = root / case
+            folders = [here / preset] + sorted(here.glob(f"{preset}-*"))
+            for folder in folders:
+                path = folder / "summary.json"
+                if path.exists():
+                    s = json.loads(path.read_text())
+                    plots = sorted(p.name for p in folder.glob("*.png"))
+                    out.append((case, folder.name, s, plots))
     return out
 
 
 def _aim(case, preset, s):
     """The wall-time aim's cell: '≤ 10 min: met' etc., or '' where there is none."""
-    aim = PAPER_TIME_AIM.get(case) if preset == "paper" else None
+    aim = (PAPER_TIME_AIM.get(case) if s.get("preset") == "paper" and not s.get("variant")
+           else None)
     if aim is None:
         return ""
     cores = s.get("cpu_count")
@@ -280,13 +296,13 @@ def render_validation(runs, link="validation"):
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for case, preset, s, _ in runs:
         n = s["counts"]
-        lines.append(f"| [`{case}`](#{case}-{preset}) | {preset} | "
+        lines.append(f"| [`{case}`](#{case}-{preset}) | {label(s)} | "
                      f"{common.duration(s['wall_time_s'])} | {_cell(how_measured([s]))} | "
                      f"{n['passed']} of {n['passed'] + n['failed']} | {verdict(s)} | "
                      f"{_aim(case, preset, s)} |")
     for case, preset, s, plots in runs:
         lines += ["", f'<a id="{case}-{preset}"></a>', "",
-                  f"## `{case}`, {preset} preset", ""]
+                  f"## `{case}`, {label(s)}" + ("" if s.get("variant") else " preset"), ""]
         if s.get("paper"):
             what = _cell(WHAT.get(case, ""))
             lines += [f"{what[:1].upper()}{what[1:]}; paper: {s['paper']}.", ""]

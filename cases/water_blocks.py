@@ -514,8 +514,12 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
                   "settle_s": cfg["settle"], "duration_s": cfg["duration"],
                   "status": {k: r["status"] for k, r in results.items()}},
     }
+    variant = "-".join(([water] if water != "elements" else [])
+                       + ([] if set(results) == {"four", "two"} else list(results)))
+    if cfg["duration"] != PRESETS[preset]["duration"]:
+        variant = "-".join(filter(None, [variant, f"{cfg['duration']:g}s"]))
     summary = common.summary(
-        CASE, preset, checks, data, clock(), threads=threads,
+        CASE, preset, checks, data, clock(), threads=threads, variant=variant or None,
         paper="Feng, Li & Oñate (2015), §4.3, Figs. 25-27",
         notes="weakly compressible water (K in data.model); rigid blocks; times from the "
               "board's removal; the outcome measure is in the checks' notes")

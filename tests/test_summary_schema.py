@@ -210,3 +210,28 @@ def test_validation_report_keeps_runs_and_lists_their_figures(tmp_path):
     # a folder without a finished run is refused, naming it
     with pytest.raises(ValueError, match="no summary.json"):
         report.archive(tmp_path, root)
+
+
+def test_a_variant_is_kept_beside_its_preset(tmp_path):
+    """A run with a variant (not the preset as it stands) is kept in CASE/PRESET-VARIANT
+    beside the preset's own run, listed after it under its own name, without the
+    preset's time aim."""
+    root = tmp_path / "validation"
+    for variant, wall in ((None, 5400.0), ("cells-four", 9000.0)):
+        s = _given()
+        s["preset"], s["wall_time_s"], s["case"] = "paper", wall, "soil_cutting"
+        if variant:
+            s["variant"] = variant
+        run = tmp_path / f"run{variant}"
+        run.mkdir()
+        (run / "summary.json").write_text(json.dumps(s))
+        report.archive(run, root)
+    runs = report.kept(root)
+    assert [f for _, f, _, _ in runs] == ["paper", "paper-cells-four"]
+    rows = [ln for ln in report.render_validation(runs).splitlines()
+            if ln.startswith("| [`soil_cutting`]")]
+    assert rows[0].startswith("| [`soil_cutting`](#soil_cutting-paper) | paper | 90 min")
+    assert rows[0].endswith("≤ 120 min on 2 cores: met |")
+    assert rows[1].startswith("| [`soil_cutting`](#soil_cutting-paper-cells-four) | "
+                              "paper, cells-four | 150 min")
+    assert rows[1].endswith("| FAIL |  |")
