@@ -487,7 +487,8 @@ class Fluid(Material):
     viscosity, its energy within 2e-5; its front leads their measurements by
     10–17 % (11–19 % inviscid; the square lattice's element water above: −0.3 to
     +11.5 %), a tongue one or two particles thick running ahead along the
-    frictionless floor (with R = 7.5 mm instead of 5 mm it leads by 9.5–15 %).
+    frictionless floor (with R = 7.5 and 3.5 mm instead of 5 mm it leads by 9.5–15
+    and 9.7–16 %: not the resolution's).
     Tried on the way, not offered: the surface cells at zero pressure with half
     masses (exact on the square lattice; on the hexagonal one the surface row,
     which then resists no compression, drifted, its speed growing from 1e-4 to
