@@ -58,7 +58,8 @@ Presets
   R = 1.4-2.6 cm, 660 discs at 76 % of the column (192 s, 8 of 10 checks,
   docs/cases.md); paper: the paper's 5528 discs of R = 3-8 mm (50 % of the
   column; its widest pores stay empty: the cells cover 1.09 of the column's
-  1.12 m²; not run).
+  1.12 m²; 77-81 min a system to 2.4 s on one thread: two columns topple, four
+  slide 0.62 m to the tank's end; docs/cases.md, docs/validation.md).
 
 Outcome measure. "Stood", "slid" or "toppled" is decided from the top block of
 the rightmost column (largest values over the run): toppled if its rotation
