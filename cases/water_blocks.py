@@ -430,9 +430,11 @@ def run_one(cfg, columns, name, out, arch=None, threads=None, folder=None):
 
 
 def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=("four", "two"),
-        water="elements"):
+        water="elements", parallel=False):
     """Run the case; returns the summary dict (also written to ``out/summary.json``).
-    ``water``: "elements" (the presets' lattice water) or "cells" (:data:`CELLS`)."""
+    ``water``: "elements" (the presets' lattice water) or "cells" (:data:`CELLS`).
+    ``parallel``: run the systems at once, one process each (each with ``threads``
+    threads; the same results as one after the other)."""
     clock = common.Stopwatch()
     cfg = dict(PRESETS[preset])
     if water == "cells":
@@ -443,9 +445,18 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
     if duration is not None:
         cfg["duration"] = float(duration)
     out = common.output_dir(CASE, out)
-    results = {}
-    for name in runs:
-        results[name] = run_one(cfg, {"four": 4, "two": 2}[name], name, out, arch, threads)
+    columns = {"four": 4, "two": 2}
+    if parallel and len(runs) > 1:
+        import concurrent.futures
+        import multiprocessing
+        with concurrent.futures.ProcessPoolExecutor(
+                max_workers=len(runs), mp_context=multiprocessing.get_context("spawn")) as pool:
+            futures = {name: pool.submit(run_one, cfg, columns[name], name, out, arch, threads)
+                       for name in runs}
+            results = {name: f.result() for name, f in futures.items()}
+    else:
+        results = {name: run_one(cfg, columns[name], name, out, arch, threads)
+                   for name in runs}
     hist = {name: {"time": r["t"], "dx_top": r["dx_top"], "rot_top": r["rot_top"],
                    "vmax_water": r["vmax_water"]} for name, r in results.items()}
     common.save_histories(out / "histories.h5", hist)
@@ -643,6 +654,9 @@ def _extra(p):
                         "(paper)")
     p.add_argument("--runs", nargs="+", choices=("four", "two"), default=("four", "two"),
                    help="which block systems to run (default both, one after the other)")
+    p.add_argument("--parallel", action="store_true",
+                   help="run the block systems at once, one process each (--threads "
+                        "threads each; the same records as one after the other)")
     p.add_argument("--duration", type=float, default=None, metavar="S",
                    help="seconds after the board's removal (default: the preset's)")
     p.add_argument("--sweep", action="store_true",
@@ -687,7 +701,8 @@ def main(argv=None):
         from tdem.errors import InputError
         raise InputError(f"duration must be > 0, got {args.duration!r}")
     s = run(args.preset, out, arch=args.arch, threads=args.threads, water=args.water,
-            duration=args.duration, runs=tuple(dict.fromkeys(args.runs)))
+            duration=args.duration, runs=tuple(dict.fromkeys(args.runs)),
+            parallel=args.parallel)
     common.print_checks(s)
     print(f"summary: {out / 'summary.json'}")
     return 0
