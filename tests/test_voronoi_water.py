@@ -135,32 +135,65 @@ def test_dam_break_on_a_random_packing():
     Without the viscosity the energy is kept: kinetic + gravitational + stored within
     2e-5 of its start to T = 3.35, when 0.71 of it is kinetic
     (test_inviscid_cells_keep_the_energy)."""
+    run = dam_break(R)
+    areas, measured = run["areas"], MARTIN_MOYCE
+    assert max(abs(x) for x, (T, _) in zip(areas, measured) if T <= 3.0) < 0.01
+    assert max(run["energies"]) <= run["start"] + 1e-6 * abs(run["start"])
+    lead = run["lead"]
+    assert min(lead) > 0.0                # ahead of the measurements at every time
+    assert max(lead) < 0.20
+
+
+def test_dam_break_lead_is_not_the_resolutions():
+    """The same dam break with discs 1.5 times larger (R = 7.5 mm, 764 discs against
+    1719): the front's lead on Martin & Moyce changes by less than 3 points at every
+    time (measured: 12.4, 17.0, 14.0, 12.2, 10.2 % at R = 5 mm; 9.5, 14.9, 12.8, 12.1,
+    9.5 % at R = 7.5 mm; 11.8, 15.8, 13.0, 11.2, 9.7 % at R = 3.5 mm, too slow for
+    the suite). The lead is the model's, not a discretisation error that finer
+    packings would take away: what the model leaves out (the floor's friction on the
+    thin leading tongue, a gate that takes time to lift) is what stands between it and
+    the measurements."""
+    fine, coarse = dam_break(R)["lead"], dam_break(1.5 * R)["lead"]
+    assert max(abs(f - c) for f, c in zip(fine, coarse)) < 0.03
+
+
+#: Martin & Moyce (1952), Fig. 3, n² = 2, a = 2.25 in: (T, x/a); None: a time with no
+#: measurement (the area check's T = 3)
+MARTIN_MOYCE = [(0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995), (3.0, None),
+                (3.345, 4.134)]
+_DAM_BREAKS = {}
+
+
+def dam_break(radius):
+    """Martin & Moyce's column h = 2a, a = 0.3 m, of random discs of 0.8-1.2 × radius
+    (76 %), K = 2 MPa, μ = 1 Pa·s, released at rest: the fronts' leads on the
+    measurements, the water's area change and the energies at MARTIN_MOYCE's times
+    (one run per radius in a test process)."""
+    if radius in _DAM_BREAKS:
+        return _DAM_BREAKS[radius]
     a = 0.3
     h = 2.0 * a
     water = tdem.Fluid(density=RHO, bulk_modulus=2e6, viscosity=1.0, voronoi=True)
     sim = tdem.Simulation(gravity=(0.0, -G), dt_fraction=0.5)
-    pos, r = packing("random", a, h, R)
-    sim.add_particles(pos, r, material=water, tolerance=R)
+    pos, r = packing("random", a, h, radius)
+    sim.add_particles(pos, r, material=water, tolerance=radius)
     tank(sim, 1.5, 1.0, 2e6)
     sim.run(steps=1)
     a0 = sim.particles.numpy()["mass"] / RHO
     e0 = sim.energy()
     start = e0["kinetic"] + e0["gravitational"] + e0["strain"] + e0["elastic"]
-    measured = [(0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995), (3.0, None),
-                (3.345, 4.134)]
     fronts, areas, energies = [], [], []
-    for T, _ in measured:
+    for T, _ in MARTIN_MOYCE:
         sim.run(until=T / math.sqrt(2.0 * G / a))
         p = sim.particles.numpy()
-        fronts.append(float(p["position"][:, 0].max() + R) / a)
+        fronts.append(float(p["position"][:, 0].max() + radius) / a)
         areas.append(float(np.minimum(sim.water_cells()["area"], a0).sum() / a0.sum()) - 1.0)
         e = sim.energy()
         energies.append(e["kinetic"] + e["gravitational"] + e["strain"] + e["elastic"])
-    assert max(abs(x) for x, (T, _) in zip(areas, measured) if T <= 3.0) < 0.01
-    assert max(energies) <= start + 1e-6 * abs(start)
-    lead = [f / z - 1.0 for f, (_, z) in zip(fronts, measured) if z is not None]
-    assert min(lead) > 0.0                # ahead of the measurements at every time
-    assert max(lead) < 0.20
+    lead = [f / z - 1.0 for f, (_, z) in zip(fronts, MARTIN_MOYCE) if z is not None]
+    out = {"lead": lead, "areas": areas, "energies": energies, "start": start}
+    _DAM_BREAKS[radius] = out
+    return out
 
 
 def test_inviscid_cells_keep_the_energy():
