@@ -42,7 +42,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: the order of the tables: the papers' order (docs/cases.md)
 ORDER = ("nine_disc", "photoelastic", "biaxial", "elastic_gravity", "uniaxial_compression",
          "wave_bar", "soil_cutting", "contact_burst", "water_blocks", "plate_loading",
-         "ellipsoid_compression", "impact_benchmarks", "angle_of_repose")
+         "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break")
 #: a few words on each case for the overview table
 WHAT = {
     "nine_disc": "nine discs compressed by four walls (Cundall & Strack)",
@@ -58,6 +58,7 @@ WHAT = {
     "ellipsoid_compression": "ellipsoids under a plate: forces on the plates (Miyata et al.)",
     "impact_benchmarks": "sphere impacts against Hertz and Coulomb theory (Chung & Ooi)",
     "angle_of_repose": "heaps of cubes beside heaps of spheres: angle of repose (Chen)",
+    "dam_break": "a water column collapsing: its surge front (Martin & Moyce)",
 }
 
 
