@@ -21,21 +21,27 @@ as digitised by PySPH's ``db_exp_data.py``); the cells' water area Σ min(A, A0)
 (water carries no tension, so a cell grown beyond its area at rest holds no more
 water); the energy (kinetic + gravitational + stored + the walls' springs).
 
-Presets: ``quick`` R = 7.5 mm cells (764 discs), R = 1 cm lattice (450);
-``paper`` R = 5 mm both (1,719 discs, 1,800 lattice particles). To T = 3.4.
+Presets: ``quick`` R = 7.5 mm cells (764 discs), R = 1 cm lattice (450), 29 s;
+``paper`` R = 5 mm both (1,719 discs, 1,800 lattice particles), 77 s (one thread,
+2026-12-06). To T = 3.4.
 
 Result and why it differs from the measurements
 -----------------------------------------------
-Both models run ahead of the measured front: the cells by 10–17 %, converged (9.5–15 %
-at R = 7.5 mm, 10–17 % at 5 mm, 9.7–16 % at 3.5 mm: tests/test_voronoi_water.py), the
-lattice's elements by −0.3 to +11.7 % (R = 1 cm). How a run is split into segments
-(``sim.run`` calls: here one per record) moves the front by up to 2.5 % for the
-elements and 0.5 % for the cells: round-off of the sums, amplified by the flow. The front is a tongue one or two
-particles thick running along the frictionless floor; what the models leave out —
-the floor's friction on that thin tongue (Nielsen et al. 2022 measure how much a
-bed's roughness and the water's viscosity slow a dam-break front) and a gate that
-takes time to lift — stands between them and the experiment. The checks compare
-each front with the measurement at 10 %, and fail where it is further off.
+Both models run ahead of the measured front. The cells by 10–17 % (paper preset:
++12.1, +17.0, +13.9, +11.5, +9.3 % at T = 0.83, 1.22, 2.0, 2.55, 3.35), the same
+within 3 points at R = 7.5, 5 and 3.5 mm (tests/test_voronoi_water.py): not a
+resolution effect. The elements by +4.4, +7.8, +6.2, +4.5, +4.2 % on the 5 mm lattice
+(paper preset, within 10 % at every time) and by −0.3 to +11.7 % on the 1 cm lattice
+(quick). So part of the cells' lead is the cells' own, not explained yet (a
+candidate: the surface cells reach 2.5 mean radii beyond the surface particles, so
+that the water's free surface lies outside them). Both fronts are tongues one or two
+particles thick on a frictionless floor; what the models leave out, the floor's
+friction on that tongue (Nielsen et al. 2022 measure how much a bed's roughness and
+the water's viscosity slow a dam-break front) and a gate that takes time to lift,
+slows the measured front. How a run is split into segments (``sim.run`` calls: here
+one per record) moves the front by up to 2.5 % for the elements and 0.5 % for the
+cells: round-off of the sums, amplified by the flow. The checks compare each front
+with the measurement at 10 %, and fail where it is further off.
 
 Outputs (``--out DIR``, default out/dam_break): per model a VTU series (.pvd),
 ``front.png`` (Z against T, both models and the measurements), ``snapshots.png``

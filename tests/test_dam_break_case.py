@@ -5,8 +5,8 @@ lattice (R = 1 cm), released at rest on a frictionless floor.
 Checked against the measurements and the conservation laws (measured on
 2026-12-06 in brackets):
 - the cells' front leads Martin & Moyce's at every time, by less than 20 %
-  (+9.8, +14.9, +12.3, +10.8, +9.6 %; the lead is the model's, not the
-  resolution's: tests/test_voronoi_water.py);
+  (+9.8, +14.9, +12.3, +10.8, +9.6 %; not the resolution's:
+  tests/test_voronoi_water.py);
 - the elements' front within 13 % of the measurements at every time (−0.3 to
   +11.7 %; how a run is split into segments moves it by up to 2.5 %: round-off,
   amplified by the flow);
