@@ -36,8 +36,9 @@ resolution effect. The elements by +4.4, +7.8, +6.2, +4.5, +4.2 % on the 5 mm la
 candidate: the surface cells reach ``physics.pcmm.cells.REACH`` = 2.5 mean radii
 beyond the surface particles, so that the water's free surface lies outside them;
 with 1.5 (R = 7.5 mm) the lead falls from +9.8, +14.9, +12.3, +10.8, +9.6 % to
-+9.7, +12.6, +10.0, +8.2, +6.9 % (2.0: +10.7, +15.4, +11.0, +9.7, +8.5 %), but 2.5
-is what holds the column at rest on random packings. Both fronts are tongues one or two
++9.7, +12.6, +10.0, +8.2, +6.9 % (2.0: +10.7, +15.4, +11.0, +9.7, +8.5 %), but
+with 1.5 the column at rest of tests/test_voronoi_water.py on its random packing
+reads pressures up to 0.89 ρgh off ρg·depth (2.5: 0.31 %). Both fronts are tongues one or two
 particles thick on a frictionless floor; what the models leave out, the floor's
 friction on that tongue (Nielsen et al. 2022 measure how much a bed's roughness and
 the water's viscosity slow a dam-break front) and a gate that takes time to lift,
