@@ -47,3 +47,18 @@ def test_cells_keep_area_and_make_no_energy(summary):
     c = common.checks_by_name(summary[0])
     assert c["cells.area_change_max"]["value"] < 0.01
     assert c["cells.energy_gain_max"]["pass"] is True
+
+
+def test_element_water_dissipates_where_the_cells_keep_their_energy(summary):
+    """Why the two models' fronts differ: with the same viscosity (1 Pa·s), the element
+    water has lost a fifth of its energy by T = 3.4 (measured −22.5 %; on the 5 mm
+    lattice −24 % by T = 3.35, its kinetic energy 228 J against the cells' 379 J),
+    the cells a twentieth (−5.1 %; −3.8 % at 5 mm): element water is slowed by a
+    dissipation of its own (the elements that break and form as it flows), which
+    brings its front nearer the measurements; the cells' front is that of water
+    that keeps its energy."""
+    c = common.checks_by_name(summary[0])
+    cells = c["cells.energy_change_end"]["value"]
+    elements = c["elements.energy_change_end"]["value"]
+    assert -0.08 < cells < 0.0
+    assert elements < -0.15

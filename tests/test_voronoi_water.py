@@ -150,11 +150,11 @@ def test_dam_break_lead_is_not_the_resolutions():
     time (measured: 12.4, 17.0, 14.0, 12.2, 10.2 % at R = 5 mm; 9.5, 14.9, 12.8, 12.1,
     9.5 % at R = 7.5 mm; 11.8, 15.8, 13.0, 11.2, 9.7 % at R = 3.5 mm, too slow for
     the suite). The lead is not a discretisation error that finer packings would take
-    away. It is not all the experiment's either: the element water on a square
-    lattice of R = 5 mm leads by only 4.4–7.8 % (cases.dam_break, paper preset), so
-    part of the cells' lead is the cells' own (not explained yet; what the models
+    away. The element water on a square lattice of R = 5 mm leads by only 4.4–7.8 %
+    (cases.dam_break, paper preset), but it loses a fifth of its energy by T = 3.35
+    where the cells lose a twentieth (tests/test_dam_break_case.py); what the models
     leave out, the floor's friction on the thin leading tongue and the gate's lift,
-    slows the measured front too)."""
+    slows the measured front."""
     fine, coarse = dam_break(R)["lead"], dam_break(1.5 * R)["lead"]
     assert max(abs(f - c) for f, c in zip(fine, coarse)) < 0.03
 
