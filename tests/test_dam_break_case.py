@@ -23,7 +23,7 @@ from cases import dam_break
 @pytest.fixture(scope="module")
 def summary(tmp_path_factory):
     out = tmp_path_factory.mktemp("dam_break")
-    return dam_break.run("quick", out, threads=1), out
+    return dam_break.run("quick", out), out
 
 
 def test_outputs(summary):
