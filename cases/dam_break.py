@@ -22,7 +22,7 @@ as digitised by PySPH's ``db_exp_data.py``); the cells' water area Σ min(A, A0)
 water); the energy (kinetic + gravitational + stored + the walls' springs).
 
 Presets: ``quick`` R = 7.5 mm cells (764 discs), R = 1 cm lattice (450), 29 s;
-``paper`` R = 5 mm both (1,719 discs, 1,800 lattice particles), 77 s (one thread,
+``paper`` R = 5 mm both (1,719 discs, 1,800 lattice particles), 71 s (one thread,
 2026-12-06). To T = 3.4.
 
 Result and why it differs from the measurements
