@@ -66,6 +66,7 @@ import numpy as np
 import tdem
 
 from . import _common as common
+from . import _pcmm
 
 CASE = "dam_break"
 A = 0.3
@@ -244,11 +245,7 @@ def run(preset="quick", out=None, arch=None, threads=None):
 
 
 def main(argv=None):
-    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
-    s = run(args.preset, out, arch=args.arch, threads=args.threads)
-    common.print_checks(s)
-    print(f"summary: {out / 'summary.json'}")
-    return 0
+    return _pcmm.main(CASE, run, __doc__, argv)
 
 
 if __name__ == "__main__":

@@ -146,8 +146,9 @@ def test_dam_break_on_a_random_packing():
 
 def test_dam_break_lead_is_not_the_resolutions():
     """The same dam break with discs 1.5 times larger (R = 7.5 mm, 764 discs against
-    1719): the front's lead on Martin & Moyce changes by less than 3 points at every
-    time (measured: 12.4, 17.0, 14.0, 12.2, 10.2 % at R = 5 mm; 9.5, 14.9, 12.8, 12.1,
+    1719): the front's lead on Martin & Moyce changes by less than 4 points at every
+    time, against leads of 10–17 % (measured, at most 2.9 points apart: 12.4, 17.0,
+    14.0, 12.2, 10.2 % at R = 5 mm; 9.5, 14.9, 12.8, 12.1,
     9.5 % at R = 7.5 mm; 11.8, 15.8, 13.0, 11.2, 9.7 % at R = 3.5 mm, too slow for
     the suite). The lead is not a discretisation error that finer packings would take
     away. The element water on a square lattice of R = 5 mm leads by only 4.4–7.8 %
@@ -156,7 +157,7 @@ def test_dam_break_lead_is_not_the_resolutions():
     leave out, the floor's friction on the thin leading tongue and the gate's lift,
     slows the measured front."""
     fine, coarse = dam_break(R)["lead"], dam_break(1.5 * R)["lead"]
-    assert max(abs(f - c) for f, c in zip(fine, coarse)) < 0.03
+    assert max(abs(f - c) for f, c in zip(fine, coarse)) < 0.04
 
 
 #: Martin & Moyce (1952), Fig. 3, n² = 2, a = 2.25 in: (T, x/a); None: a time with no
