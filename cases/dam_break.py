@@ -36,7 +36,7 @@ That front leads Martin & Moyce's by +13.5, +17.1, +14.0, +12.3, +10.7 % at T =
 experiment's own scale (a = 2.25 in, surface tension 0.07 N/m) still by +13.4,
 +16.5, +13.2, +11.2, +9.5 % (the tables beside the script). An instantly released
 column runs 10–17 % ahead of the measured one whatever the floor and the viscosity:
-the measurements lag by what none of these models has, such as the gate's lift. The issue's aim of
+the measurements lag by what none of these models has, such as the gate's lift.
 10 % against Martin & Moyce at every time is therefore not a fair aim for these
 models; the case checks it (and fails) beside the fair one, 10 % against the
 reference.
