@@ -17,6 +17,7 @@ import time
 import numpy as np
 
 import tdem
+from cases._pcmm import water_tank
 
 R, W, H, RHO, G = 0.005, 0.3, 0.5, 1000.0, 9.81
 
@@ -29,10 +30,7 @@ def model(kind, cells, threads):
     pos, r = (tdem.pack.cross(W, H, R) if kind == "hexagonal" else
               tdem.pack.random(W, H, 0.8 * R, 1.2 * R, seed=1, target_fraction=0.76))
     sim.add_particles(pos, r, material=water, tolerance=R)
-    wall = tdem.LinearContact(kn=3.0 * k, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (W, 0.0), contact=wall)
-    sim.add_wall((0.0, 2 * H), (0.0, 0.0), contact=wall)
-    sim.add_wall((W, 0.0), (W, 2 * H), contact=wall)
+    water_tank(sim, W, 2 * H, k)
     return sim, len(r)
 
 

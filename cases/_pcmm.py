@@ -1,7 +1,8 @@
 """Shared helpers of the PCMM precision tests of Feng, Li & Oñate (2015) §3
 (elastic_gravity, uniaxial_compression, wave_bar): the regular / cross / random
 PCMM particle models and the FVM block models of one rectangular body, boundary
-selections, read-outs at monitoring points, the run loop and common plots.
+selections, read-outs at monitoring points, the run loop and common plots; and the
+frictionless tank of the water cases (:func:`water_tank`).
 
 A model is described by a small dict ``spec``:
 
@@ -28,6 +29,16 @@ import tdem
 from . import _common as common
 
 COLORS = {"regular": "C0", "cross": "C1", "random": "C2", "fvm": "C3", "fvm_cross": "C4"}
+
+
+def water_tank(sim, width, height, bulk_modulus):
+    """A tank's floor (y = 0, x from 0 to ``width``) and two sides ``height`` high:
+    frictionless segment walls of the particle–wall law k_n = 3K for water of bulk
+    modulus K (``bulk_modulus``), as the water cases and tests use."""
+    wall = tdem.LinearContact(kn=3.0 * bulk_modulus, ks=0.0, friction=0.0)
+    sim.add_wall((0.0, 0.0), (width, 0.0), contact=wall)
+    sim.add_wall((0.0, height), (0.0, 0.0), contact=wall)
+    sim.add_wall((width, 0.0), (width, height), contact=wall)
 # open markers of different shapes, so that models that agree stay visible on top of
 # each other
 MARKERS = {"regular": "s", "cross": "^", "random": "o", "fvm": "D", "fvm_cross": "v"}

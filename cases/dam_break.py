@@ -124,10 +124,7 @@ def build(model, radius, arch=None, threads=None):
         water = tdem.Fluid(density=RHO, bulk_modulus=K, viscosity=MU)
         pos, r = tdem.pack.regular(A, H, radius)
     sim.add_particles(pos, r, material=water, tolerance=radius)
-    wall = tdem.LinearContact(kn=3.0 * K, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (TANK, 0.0), contact=wall)
-    sim.add_wall((0.0, 2.0 * H), (0.0, 0.0), contact=wall)
-    sim.add_wall((TANK, 0.0), (TANK, 2.0 * H), contact=wall)
+    _pcmm.water_tank(sim, TANK, 2.0 * H, K)
     return sim, len(pos)
 
 

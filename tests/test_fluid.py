@@ -39,6 +39,7 @@ import numpy as np
 import pytest
 
 import tdem
+from cases._pcmm import water_tank as tank
 from physics import pcmm
 
 R, W, H = 0.01, 0.4, 0.5
@@ -65,15 +66,6 @@ def column():
         errs_edge.append(pressure_errors(p, R, 0.24))
     return {"n": len(g.ids), "vmax": np.array(vmax), "err": np.array(errs),
             "err_edge": np.array(errs_edge)}
-
-
-def tank(sim, width, height, k):
-    """The tank's floor and sides, ``width`` apart and ``height`` high: frictionless
-    walls of the particle–wall law k_n = 3K (the water's bulk modulus K = ``k``)."""
-    wall = tdem.LinearContact(kn=3.0 * k, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (width, 0.0), contact=wall)
-    sim.add_wall((0.0, height), (0.0, 0.0), contact=wall)
-    sim.add_wall((width, 0.0), (width, height), contact=wall)
 
 
 def pressure_errors(p, above, dmin):

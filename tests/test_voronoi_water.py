@@ -28,6 +28,7 @@ import numpy as np
 import pytest
 
 import tdem
+from cases._pcmm import water_tank as tank
 from cases.dam_break import vof_front
 
 R, W, H = 0.005, 0.3, 0.5
@@ -42,13 +43,6 @@ def packing(kind, width, height, radius):
         return tdem.pack.cross(width, height, radius)
     return tdem.pack.random(width, height, 0.8 * radius, 1.2 * radius, seed=1,
                             target_fraction=0.76)
-
-
-def tank(sim, width, height, k):
-    wall = tdem.LinearContact(kn=3.0 * k, ks=0.0, friction=0.0)
-    sim.add_wall((0.0, 0.0), (width, 0.0), contact=wall)
-    sim.add_wall((0.0, height), (0.0, 0.0), contact=wall)
-    sim.add_wall((width, 0.0), (width, height), contact=wall)
 
 
 @pytest.fixture(scope="module", params=["square", "hexagonal", "random"])

@@ -223,6 +223,10 @@ def main(argv=None):
     args = p.parse_args(argv)
     if args.dx <= 0.0 or args.dx > 0.05:
         p.error(f"--dx must be in (0, 0.05] m, got {args.dx}")
+    if args.procs < 1:
+        p.error(f"--procs must be at least 1, got {args.procs}")
+    if args.until <= 0.0:
+        p.error(f"--until must be positive, got {args.until}")
     if args.a <= 0.0:
         p.error(f"--a must be positive, got {args.a}")
     if args.sigma < 0.0:
