@@ -65,18 +65,112 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
                  lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                  hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
                  detail: ti.template(), laws: ti.template(), per):
-    """Contact in slot k of particle i (the owner, i < j); xi, vi, wi, ri, mi, li are
-    i's position, velocity, spin, radius, mass and law group; ``laws`` the registered
-    contact laws (:mod:`physics.contact_law`); ``per`` the periodic axes (j is taken
-    at its image nearest to i).
+    """Contact in slot k of particle i (the owner, i < j) with partner j = nbr[i, k]:
+    two discs (:func:`disc_pair`) or two spheres (:func:`sphere_pair`). xi, vi, wi,
+    ri, mi, li are i's position, velocity, spin, radius, mass and law group; ``laws``
+    the registered contact laws (:mod:`physics.contact_law`); ``per`` the periodic
+    axes (j is taken at its image nearest to i).
 
     Updates the history and returns (f_i, M_i, M_j, dissipated energy). With
     ``detail`` also stores the normal, the scalar forces and the overlap (for
-    output, stress and energy). The history vector holds the law's columns, the
-    rolling couple, rotation and broken flag (from column R) and the overlap offset
-    u0 (the last column); in 3D only the law's columns."""
-    dim = ti.static(xi.n)
-    R = ti.static(history_width(laws, tangent_dim(dim)))
+    output, stress and energy)."""
+    f = xi * 0.0
+    m_on_i = spin_zero(ti.static(xi.n))
+    m_on_j = spin_zero(ti.static(xi.n))
+    diss = 0.0
+    if ti.static(xi.n == 2):
+        f, m_on_i, m_on_j, diss = disc_pair(i, k, xi, vi, wi, ri, mi, li, pos, vel, omega,
+                                            prop, plaw, lawp, lawpair, nbr, hist, cn, cs,
+                                            dt, detail, laws, per)
+    else:
+        f, m_on_i, m_on_j, diss = sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos, vel, omega,
+                                              prop, plaw, lawp, lawpair, nbr, hist, cn, cs,
+                                              dt, detail, laws, per)
+    return f, m_on_i, m_on_j, diss
+
+
+@ti.func
+def sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template(),
+                omega: ti.template(), prop: ti.template(), plaw: ti.template(),
+                lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
+                hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
+                detail: ti.template(), laws: ti.template(), per):
+    """:func:`pair_contact` of two spheres. The pair is tested on the squared distance
+    first: of the listed pairs of a dense bed a third or more do not touch, and those
+    cost a load of the partner's position and radius and no square root. The history
+    holds the law's columns, then those of the rolling resistance when a law has one."""
+    R = ti.static(history_width(laws, tangent_dim(3)))
+    j = nbr[i, k]
+    d = image(pos[j] - xi, per)
+    r2 = d.dot(d)
+    pj = prop[j]
+    rj = pj[PROP_RADIUS]
+    rs = ri + rj
+    f = ti.Vector([0.0, 0.0, 0.0])
+    m_on_i = ti.Vector([0.0, 0.0, 0.0])
+    m_on_j = ti.Vector([0.0, 0.0, 0.0])
+    diss = 0.0
+    if r2 < rs * rs:
+        dist = ti.sqrt(r2)
+        u = rs - dist
+        n = ti.Vector([1.0, 0.0, 0.0])      # (coincident centres)
+        if dist > 0.0:
+            n = d * (1.0 / dist)
+        # the contact point's arms a = R − u/2 and the relative velocity of j's
+        # contact point against i's: v_j − v_i − (a_j ω_j + a_i ω_i) × n
+        ai = ri - 0.5 * u
+        aj = rj - 0.5 * u
+        vrel = vel[j] - vi - (aj * omega[j] + ai * wi).cross(n)
+        vn = vrel.dot(n)
+        L = lawpair[li, plaw[j]]
+        mj = pj[PROP_MASS]
+        # R* = R_i R_j/(R_i + R_j) and m* = m_i m_j/(m_i + m_j) by one division
+        inv = 1.0 / (rs * (mi + mj))
+        reff = ri * rj * (mi + mj) * inv
+        meff = mi * mj * rs * inv
+        h = hist[i, k]
+        fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
+            laws, lawp, L, u, vn, vrel - vn * n, meff, reff, dt, h, n)
+        f = -fn * n + ft
+        # the moments (a n) × f of the contact force at each branch: n × f = n × F_t
+        nxf = n.cross(ft)
+        m_on_i = ai * nxf
+        m_on_j = aj * nxf
+        diss = d1
+        if ti.static(h.n >= R + 7):
+            # rolling resistance (the columns after the law's)
+            m, m_tot, th, brk, d2 = rolling_couple_3d(
+                lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - omega[j], n, dt,
+                get_columns(h, R, 3), get_columns(h, R + 3, 3), h[R + 6])
+            h = put_columns(h, R, m)
+            h = put_columns(h, R + 3, th)
+            h[R + 6] = brk
+            m_on_i += m_tot
+            m_on_j -= m_tot
+            diss += d2
+        hist[i, k] = h
+        if ti.static(detail):
+            cn[i, k] = n
+            cs[i, k] = ti.Vector([fn, ft.norm(), u])
+    else:
+        h = hist[i, k]
+        if h.dot(h) != 0.0:
+            hist[i, k] = zero_history(h)
+        if ti.static(detail):
+            cs[i, k] = ti.Vector([0.0, 0.0, rs - ti.sqrt(r2)])
+    return f, m_on_i, m_on_j, diss
+
+
+@ti.func
+def disc_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template(),
+              omega: ti.template(), prop: ti.template(), plaw: ti.template(),
+              lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
+              hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
+              detail: ti.template(), laws: ti.template(), per):
+    """:func:`pair_contact` of two discs. The history vector holds the law's columns,
+    the rolling couple, rotation and broken flag (from column R) and the overlap
+    offset u0 (the last column)."""
+    R = ti.static(history_width(laws))
     U0 = ti.static(R + 3)
     j = nbr[i, k]
     pj = prop[j]
@@ -87,14 +181,11 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     # physics.pcmm.gather, lowered as the two separate): the contact law takes over
     # from the elements without a force jump (no energy from nowhere)
     h = hist[i, k]
-    u0 = 0.0
-    u = u_geo
-    if ti.static(dim == 2):
-        u0 = ti.min(h[U0], ti.max(u_geo, 0.0))
-        u = u_geo - u0
-    f = vec_zero(dim)
-    m_on_i = spin_zero(dim)
-    m_on_j = spin_zero(dim)
+    u0 = ti.min(h[U0], ti.max(u_geo, 0.0))
+    u = u_geo - u0
+    f = ti.Vector([0.0, 0.0])
+    m_on_i = 0.0
+    m_on_j = 0.0
     diss = 0.0
     if u > 0.0:
         wj = omega[j]
@@ -106,62 +197,27 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
         inv = 1.0 / ((ri + rj) * (mi + mj))
         reff = ri * rj * (mi + mj) * inv
         meff = mi * mj * (ri + rj) * inv
-        fn_el = 0.0
-        fn = 0.0
-        ft = tangent_part(vrel, n) * 0.0
-        kn = 0.0
-        cnd = 0.0
-        d1 = 0.0
-        if ti.static(dim == 2):
-            fn_el, fn, ft, kn, cnd, d1, h = law_force(
-                laws, lawp, L, u, vn, tangent_part(vrel, n), meff, reff, dt, h)
-        else:
-            fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
-                laws, lawp, L, u, vn, tangent_part(vrel, n), meff, reff, dt, h, n)
-        fs_tot = 0.0
-        if ti.static(dim == 2):
-            fs_tot = ft[0]
-            m, m_tot, th, brk, d2 = rolling_couple(
-                lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
-            f = -fn * n + tangent_vector(ft, n)
-            m_on_i = ai * fs_tot + m_tot
-            m_on_j = aj * fs_tot - m_tot
-            h[R] = m
-            h[R + 1] = th
-            h[R + 2] = brk
-            diss = d1 + d2
-        else:
-            fs_tot = ft.norm()
-            f = -fn * n + ft
-            # the moments (a n) × f of the contact force at each branch: n × f = n × F_t
-            nxf = moment(n, ft)
-            m_on_i = ai * nxf
-            m_on_j = aj * nxf
-            diss = d1
-            if ti.static(h.n >= R + 7):
-                # rolling resistance (the columns after the law's)
-                m, m_tot, th, brk, d2 = rolling_couple_3d(
-                    lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, n, dt,
-                    get_columns(h, R, 3), get_columns(h, R + 3, 3), h[R + 6])
-                h = put_columns(h, R, m)
-                h = put_columns(h, R + 3, th)
-                h[R + 6] = brk
-                m_on_i += m_tot
-                m_on_j -= m_tot
-                diss += d2
-        if ti.static(dim == 2):
-            h[U0] = u0
+        fn_el, fn, ft, kn, cnd, d1, h = law_force(
+            laws, lawp, L, u, vn, tangent_part(vrel, n), meff, reff, dt, h)
+        fs_tot = ft[0]
+        m, m_tot, th, brk, d2 = rolling_couple(
+            lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
+        f = -fn * n + tangent_vector(ft, n)
+        m_on_i = ai * fs_tot + m_tot
+        m_on_j = aj * fs_tot - m_tot
+        h[R] = m
+        h[R + 1] = th
+        h[R + 2] = brk
+        diss = d1 + d2
+        h[U0] = u0
         hist[i, k] = h
         if ti.static(detail):
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, fs_tot, u])
     else:
-        if ti.static(dim == 2):
-            h = zero_history(h)
-            h[U0] = u0
-            hist[i, k] = h
-        elif h.dot(h) != 0.0:
-            hist[i, k] = zero_history(h)
+        h = zero_history(h)
+        h[U0] = u0
+        hist[i, k] = h
         if ti.static(detail):
             cs[i, k] = ti.Vector([0.0, 0.0, u])
     return f, m_on_i, m_on_j, diss
@@ -479,6 +535,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     g = gravity(simp, dim)
     alpha = simp[P_ALPHA]
     alpha_l = simp[P_ALPHA_LOCAL]
+    damped = alpha != 0.0 or alpha_l != 0.0
     half_skin2 = (0.5 * simp[P_SKIN]) ** 2
     per = periodic_axes(simp, dim)
 
@@ -689,9 +746,15 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         v0 = vel[i]
         w0 = omega[i]
         ftot = f + m * g
-        # local and global damping, central differences (tdem.integrate)
-        v1, fd = damped_leapfrog(v0, ftot, m, alpha, alpha_l, dt)
-        w1, md = damped_leapfrog(w0, tq, inertia, alpha, alpha_l, dt)
+        # local and global damping, central differences (tdem.integrate); without
+        # damping the same numbers by the plain leapfrog
+        v1 = v0 + ftot / m * dt
+        w1 = w0 + tq / inertia * dt
+        fd = vec_zero(dim)
+        md = spin_zero(dim)
+        if damped:
+            v1, fd = damped_leapfrog(v0, ftot, m, alpha, alpha_l, dt)
+            w1, md = damped_leapfrog(w0, tq, inertia, alpha, alpha_l, dt)
         q1 = angle[i]
         ell = False
         lmid = w0 * 0.0
@@ -735,13 +798,20 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         vm = 0.5 * (v0 + v1)
         wm = 0.5 * (w0 + w1)
         x0 = pos[i]
-        w_damp = ((fd - alpha * m * 0.5 * (v0 + vfree)).dot(vm)
-                  + spin_dot(md - alpha * inertia * 0.5 * (w0 + wfree), wm, dim)) * dt
-        w_fix = m * (v1 - vfree).dot(vm) + inertia * spin_dot(w1 - wfree, wm, dim)
-        ework[i] += ti.Vector([(fc.dot(vm) + spin_dot(tc, wm, dim)) * dt,
-                               fx_cont.dot(vm) * dt, m * g.dot(vm) * dt, w_damp, w_fix,
-                               (fa.dot(vm) + spin_dot(ma, wm, dim)) * dt, 0.0])
-        if alpha != 0.0 or alpha_l != 0.0 or fx != 0:
+        # (the columns that stay zero, as damping and fixes in a model without them,
+        # are not written)
+        ework[i][0] += (fc.dot(vm) + spin_dot(tc, wm, dim)) * dt
+        ework[i][2] += m * g.dot(vm) * dt
+        if ti.static(continuum):
+            ework[i][1] += fx_cont.dot(vm) * dt
+        if ti.static(loads):
+            ework[i][5] += (fa.dot(vm) + spin_dot(ma, wm, dim)) * dt
+        if damped or fx != 0:
+            w_damp = ((fd - alpha * m * 0.5 * (v0 + vfree)).dot(vm)
+                      + spin_dot(md - alpha * inertia * 0.5 * (w0 + wfree), wm, dim)) * dt
+            w_fix = m * (v1 - vfree).dot(vm) + inertia * spin_dot(w1 - wfree, wm, dim)
+            ework[i][3] += w_damp
+            ework[i][4] += w_fix
             eacc[i] += ti.Vector([-w_damp, w_fix])
         if ti.static(detail):
             force[i] = fc + fx_cont
