@@ -55,16 +55,32 @@ def frame_of(s, q):
 
 
 @ti.func
+def shape_row(s, q, r):
+    """A particle's shape matrix R diag(a², b², c²) Rᵀ (r² I for a sphere), its nine
+    entries row by row (the step keeps them per particle: ``turn``)."""
+    m = el.shape_matrix(frame_of(s, q), axes_of(s, r))
+    return ti.Vector([m[0, 0], m[0, 1], m[0, 2], m[1, 0], m[1, 1], m[1, 2],
+                      m[2, 0], m[2, 1], m[2, 2]])
+
+
+@ti.func
+def shape_of_row(v):
+    """The shape matrix kept by :func:`shape_row`."""
+    return ti.Matrix([[v[0], v[1], v[2]], [v[3], v[4], v[5]], [v[6], v[7], v[8]]])
+
+
+@ti.func
 def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
                    vel: ti.template(), omega: ti.template(), prop: ti.template(),
-                   plaw: ti.template(), angle: ti.template(), shp: ti.template(),
+                   plaw: ti.template(), turn: ti.template(), shp: ti.template(),
                    lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                    hist: ti.template(), cn: ti.template(), cs: ti.template(),
                    flags: ti.template(), dt, detail: ti.template(), laws: ti.template(),
                    per):
     """Contact in slot k of particle i (the owner) when either body is an ellipsoid
-    (``mati``: i's shape matrix, ``abci`` its semi-axes); returns (f_i, M_i, M_j,
-    dissipated energy), as :func:`tdem.step.pair_contact`."""
+    (``mati``: i's shape matrix, ``abci`` its semi-axes; ``turn`` every particle's
+    shape matrix, :func:`shape_row`); returns (f_i, M_i, M_j, dissipated energy), as
+    :func:`tdem.step.pair_contact`."""
     R = ti.static(history_width(laws, tangent_dim(3)))
     NC = ti.static(R)          # the last normal: columns NC … NC + 2
     ST = ti.static(R + 3)      # the state
@@ -72,24 +88,33 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
     pj = prop[j]
     sj = shp[j]
     abcj = axes_of(sj, pj[PROP_RADIUS])
-    matj = el.shape_matrix(frame_of(sj, angle[j]), abcj)
     d = image(pos[j] - xi, per)
     dist = d.norm()
     h = hist[i, k]
-    n0 = ti.Vector([h[NC], h[NC + 1], h[NC + 2]])
-    if h[ST] <= 0.0 or n0.dot(d) <= 0.0:
-        n0 = d / ti.max(dist, 1e-300)
-    tol = 1e-10 * (abci.max() + abcj.max())
-    u, n, status = el.penetration(mati, matj, d, n0, tol, MAXIT)
     f = ti.Vector([0.0, 0.0, 0.0])
     m_on_i = ti.Vector([0.0, 0.0, 0.0])
     m_on_j = ti.Vector([0.0, 0.0, 0.0])
     diss = 0.0
-    if status == 2:
-        ti.atomic_add(flags[F_NONCONV], 1)
+    u = -1.0
+    status = 1
+    n = d * 0.0
+    # bodies whose bounding spheres are apart cannot touch: no penetration search
+    # (except on a step that records every pair's gap for output)
+    far = False
+    if ti.static(not detail):
+        far = dist >= abci.max() + abcj.max()
+    if not far:
+        matj = shape_of_row(turn[j])
+        n0 = ti.Vector([h[NC], h[NC + 1], h[NC + 2]])
+        if h[ST] <= 0.0 or n0.dot(d) <= 0.0:
+            n0 = d / ti.max(dist, 1e-300)
+        tol = 1e-10 * (abci.max() + abcj.max())
+        u, n, status = el.penetration(mati, matj, d, n0, tol, MAXIT)
+        if status == 2:
+            ti.atomic_add(flags[F_NONCONV], 1)
     if status != 1 and u > 0.0:
         hi, pi = el.support(mati, n)
-        hj, pjo = el.support(matj, n)
+        hj, pjo = el.support(shape_of_row(turn[j]), n)
         c = 0.5 * (pi + d - pjo)            # from x_i; j's support point is x_j − M_j n/h_j
         ri_arm = c
         rj_arm = c - d

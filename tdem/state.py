@@ -73,8 +73,9 @@ ENGINE = (
     Array("pos0", "particle", "D", "f", "dynamic",
           doc="position at the start (displacement; shifted with a periodic wrap)"),
     Array("facc", "particle", "DS", "f", "scratch", doc="force and moment sums of a step"),
-    Array("turn", "particle", {2: 2, 3: 0}, "f", "scratch",
-          doc="2D: cos θ, sin θ of each particle's angle at the step's start"),
+    Array("turn", "particle", {2: 2, 3: 9}, "f", "scratch",
+          doc="cos θ, sin θ of each particle's angle at the step's start (2D); in 3D "
+              "each particle's shape matrix, row by row (models with ellipsoids)"),
     Array("eacc", "particle", 2, "f", "dynamic", doc="dissipated energy, boundary work (J/m)"),
     Array("estate", "particle", 2, "f", "dynamic", doc="kinetic, gravitational energy at t_n"),
     Array("ework", "particle", 7, "f", "dynamic",

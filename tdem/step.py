@@ -544,6 +544,11 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         ti.loop_config(serialize=serial)
         for i in range(n):
             turn[i] = ti.Vector([ti.cos(angle[i]), ti.sin(angle[i])])
+    if ti.static(dim == 3 and (shapes & SHAPES_SMOOTH)):
+        # each particle's shape matrix once, likewise
+        ti.loop_config(serialize=serial)
+        for i in range(n):
+            turn[i] = shaped3d.shape_row(shp[i], angle[i], prop[i][PROP_RADIUS])
 
     # 1. contact forces at x_n: each pair once, by its owner (the lower index). On one
     #    thread the partner's share goes straight into its sum; in parallel it is kept
@@ -594,7 +599,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             if ti.static(dim == 3 and (shapes & SHAPES_SMOOTH)):
                 # an ellipsoid's semi-axes and shape matrix (a sphere's: r, r, r)
                 shi = shaped3d.axes_of(shp[i], pi[PROP_RADIUS])
-                mati = shaped3d.el.shape_matrix(shaped3d.frame_of(shp[i], angle[i]), shi)
+                mati = shaped3d.shape_of_row(turn[i])
                 ishaped = shp[i][3] > 0.0
             if ti.static(dim == 3 and (shapes & SHAPES_POLY)):
                 ipoly = shp[i][3] < 0.0
@@ -636,7 +641,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                             if not done and (ishaped or shp[nbr[i, k]][3] > 0.0):
                                 fk, mk, mjk, dk = shaped3d.ellipsoid_pair(
                                     i, k, xi, vi, wi, pi[PROP_MASS], li, mati, shi, pos, vel,
-                                    omega, prop, plaw, angle, shp, lawp, lawpair, nbr, hist, cn, cs,
+                                    omega, prop, plaw, turn, shp, lawp, lawpair, nbr, hist, cn, cs,
                                     flags, dt, detail, laws, per)
                                 done = True
                         if not done:
