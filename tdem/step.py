@@ -617,13 +617,14 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     if ti.static(detail):
                         cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
                 else:
-                    if skip == 2:
-                        # a same-body pair at the start: the contact law counts from now
-                        j = nbr[i, k]
-                        u = pi[PROP_RADIUS] + prop[j][PROP_RADIUS] - (pos[j] - xi).norm()
-                        h0 = hist[i, k]
-                        h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
-                        hist[i, k] = h0
+                    if ti.static(continuum):
+                        if skip == 2:
+                            # a same-body pair at the start: the contact law counts from now
+                            j = nbr[i, k]
+                            u = pi[PROP_RADIUS] + prop[j][PROP_RADIUS] - (pos[j] - xi).norm()
+                            h0 = hist[i, k]
+                            h0[ti.static(history_width(laws) + 3)] = ti.max(u, 0.0)
+                            hist[i, k] = h0
                     shaped = False
                     if ti.static(shapes and dim == 2):
                         shaped = ishaped or shp[nbr[i, k]][2] > 0.0
