@@ -69,6 +69,7 @@ def init(arch=None, threads=None):
     if threads is not None:
         kwargs["cpu_max_num_threads"] = threads
     kwargs["advanced_optimization"] = advanced_optimization(name)
+    kwargs["cfg_optimization"] = cfg_optimization()
     ti.init(**kwargs)
     launch.reset()
     actual = "gpu" if ti.lang.impl.current_cfg().arch in (ti.cuda, ti.vulkan, ti.metal, ti.opengl) else "cpu"
@@ -92,6 +93,21 @@ def advanced_optimization(name):
     if env:
         return env == "1"
     return name != "gpu"
+
+
+def cfg_optimization():
+    """Whether Taichi's control-flow-graph pass (store forwarding and dead stores over
+    a kernel's whole body) runs: off unless ``$TDEM_CFG_OPTIMIZATION=1``. Its cost
+    grows faster than the size of a kernel, and the step kernels of shaped particles
+    are large: on 2 cores the first build of a model of ellipsoids took 135 s with it
+    and 18 s without, of polyhedra 143 s and 27 s, of superellipses 44 s and 6.5 s, of
+    spheres 46 s and 9.6 s. LLVM's own passes do most of its work afterwards: the
+    sphere and disc packs run as fast without it, ellipsoids and cubes 3–5 % slower
+    (``benchmarks/RESULTS.md``)."""
+    env = os.environ.get("TDEM_CFG_OPTIMIZATION", "")
+    if env not in ("", "0", "1"):
+        raise InputError(f"TDEM_CFG_OPTIMIZATION must be 0 or 1, got {env!r}")
+    return env == "1"
 
 
 def _warn_fallback(asked, actual, stacklevel):

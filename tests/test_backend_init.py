@@ -19,6 +19,7 @@ def _child(code, **env):
     e = dict(os.environ)
     e.pop("TDEM_ARCH", None)
     e.pop("TDEM_THREADS", None)
+    e.pop("TDEM_CFG_OPTIMIZATION", None)
     e.update(env)
     return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, env=e,
                           capture_output=True, text=True, timeout=120)
@@ -90,3 +91,29 @@ def test_bad_thread_counts_are_named():
         """, TDEM_THREADS="many")
     assert r.returncode == 0, r.stderr[-2000:]
     assert "REFUSED TDEM_THREADS must be a whole number >= 1, got 'many'" in r.stdout
+
+
+@pytest.mark.parametrize("env, expected", [(None, "False"), ("0", "False"), ("1", "True")])
+def test_control_flow_optimisation_off_unless_asked(env, expected):
+    # (off by default: it makes the first build of the step of shaped particles take
+    # minutes instead of seconds, tdem.backend.cfg_optimization)
+    r = _child("""
+        import taichi as ti
+        import tdem
+        tdem.Simulation()
+        print("CFG", ti.lang.impl.current_cfg().cfg_optimization)
+        """, **({} if env is None else {"TDEM_CFG_OPTIMIZATION": env}))
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert f"CFG {expected}" in r.stdout
+
+
+def test_bad_cfg_optimisation_setting_is_named():
+    r = _child("""
+        import tdem
+        try:
+            tdem.Simulation()
+        except tdem.InputError as e:
+            print("REFUSED", e)
+        """, TDEM_CFG_OPTIMIZATION="yes")
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "REFUSED TDEM_CFG_OPTIMIZATION must be 0 or 1, got 'yes'" in r.stdout

@@ -13,15 +13,17 @@ with the optimisation on, so it would not notice such a variable in a kernel.
 The test runs one model with every kind of kernel — discs with the linear law with
 rolling resistance and with Hertz–Mindlin, superellipses, walls (one moving), a PCMM
 body with a non-reflecting boundary, a JWL charge, a deformable block, a rigid block,
-point–edge couplings of block to block and disc to block — and a periodic pack, in two
-processes on the CPU: with ``TDEM_ADVANCED_OPTIMIZATION=0`` and ``=1``. Both must
+point–edge couplings of block to block and disc to block — a periodic pack, and in
+3D spheres with an ellipsoid, spheres with a cube (both periodic along x, on a mesh
+floor) and spheres with rolling resistance, in two processes on the CPU: with ``TDEM_ADVANCED_OPTIMIZATION=0`` and ``=1``. Both must
 finish, and positions, velocities, spins, angles, plastic strains and energies agree
 to 1e-10 relative (the two builds round some floating-point operations differently:
 about 1e-16 a step, which the periodic pack's many contacts grow over the 150
 steps; measured up to 6e-12 in a spin).
-The two processes run side by side; on two cores the test takes about 85 s with an
-empty kernel cache (the build with the optimisation, mostly its step kernel with
-shaped particles and the PCMM stresses) and 20 s with Taichi's offline cache filled.
+(A 3D step once read a history column past its width in a branch that the
+optimisation removed: the build without it stopped in Taichi's scalarize pass.)
+The two processes run side by side; on two cores the test takes about 65 s with an
+empty kernel cache and 20 s with Taichi's offline cache filled.
 
 Run as a script, this module prints the model's state as JSON on the line starting
 with ``RESULT``.
@@ -99,16 +101,62 @@ def _periodic():
     return sim, np.zeros(0, int)
 
 
+def _rolling_3d():
+    """3D spheres with rolling resistance rolling on a mesh floor and into one another."""
+    import tdem
+    rolling = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.5, restitution=0.5,
+                                rolling=tdem.RollingResistance(delta=0.3, model=1))
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=2e-5)
+    r = 0.01
+    sim.add_particles([[0.0, 0.0, r - 1e-4], [2 * r - 1e-4, 0.0, r - 1e-4]], r,
+                      density=2500.0, contact=rolling,
+                      velocity=[[0.3, 0.1, 0.0], [-0.2, 0.0, 0.0]],
+                      omega=[[-10.0, 30.0, 0.0], [0.0, -20.0, 5.0]])
+    v, t = tdem.surfaces.plane((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), size=0.4, divisions=2)
+    sim.add_mesh(v, t, contact=rolling)
+    return sim, np.zeros(0, int)
+
+
+def _three_d(shape):
+    """3D: spheres and an ellipsoid or a cube (the two cannot share a model) on a mesh
+    floor, periodic along x, everything touching from the first step (a sphere across
+    the periodic boundary)."""
+    import tdem
+    hertz = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.4, restitution=0.6)
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, -9.81), dt=2e-5)
+    sim.periodic(x=(0.0, 0.2))
+    r = 0.01
+    sim.add_particles([[r - 5e-5, 0.0, r - 1e-4], [0.2 - r - 5e-5, 0.0, r - 1e-4], [0.1, 0.0, r - 1e-4],
+                       [0.1, 0.0, 3 * r - 3e-4]], r, density=2500.0, contact=hertz,
+                      velocity=[[0.3, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, -0.2],
+                                [0.1, 0.0, -0.3]])
+    if shape == "ellipsoid":
+        kw = dict(shape=tdem.Ellipsoid(0.015, 0.012, 0.008), contact=hertz)
+    else:
+        kw = dict(shape=tdem.Polyhedron.cube(0.016),
+                  contact=tdem.VolumeContact(young=1e7, friction=0.5, restitution=0.5))
+    half_y = 0.012 if shape == "ellipsoid" else 0.008
+    body = sim.add_particles([[0.1, r + half_y - 1e-4, 0.008 - 1e-4]], density=2500.0,
+                             velocity=(0.2, -0.1, 0.0), omega=(0.0, 0.0, 5.0), **kw)
+    v, t = tdem.surfaces.plane((0.1, 0.0, 0.0), (0.0, 0.0, 1.0), size=0.6, divisions=4)
+    sim.add_mesh(v, t, contact=hertz)
+    return sim, body.ids
+
+
 def _state(steps):
     out = {}
-    for name, build in (("everything", _everything), ("periodic", _periodic)):
+    for name, build in (("everything", _everything), ("periodic", _periodic),
+                        ("ellipsoids", lambda: _three_d("ellipsoid")),
+                        ("polyhedra", lambda: _three_d("cube")), ("rolling_3d", _rolling_3d)):
         sim, shapes = build()
-        start = sim.particles.numpy()["angle"][shapes]
+        turn = "angle" if sim.dim == 2 else "orientation"     # (3D: quaternions)
+        start = sim.particles.numpy()[turn][shapes]
         sim.run(steps=steps)
-        p = sim.particles.numpy()
+        p = dict(sim.particles.numpy())
+        p["angle"] = p[turn]
         out[name] = {k: np.asarray(p[k]).tolist() for k in KEYS}
         out[name]["shape_turn"] = (p["angle"][shapes] - start).tolist()
-        out[name]["plastic_strain"] = np.asarray(p["plastic_strain"]).tolist()
+        out[name]["plastic_strain"] = np.asarray(p.get("plastic_strain", [])).tolist()
         out[name]["energy"] = sim.energy()
         out[name]["steps"] = sim.steps
         out[name]["contacts"] = len(sim.contacts.numpy()["pairs"])
@@ -151,7 +199,7 @@ def test_kernels_build_and_agree_with_and_without_advanced_optimisation():
             if proc.poll() is None:
                 proc.kill()
                 proc.communicate()
-    for model in ("everything", "periodic"):
+    for model in ("everything", "periodic", "ellipsoids", "polyhedra", "rolling_3d"):
         a, b = off[model], on[model]
         assert a["steps"] == b["steps"] == STEPS
         for k in KEYS + ("plastic_strain",):
@@ -168,7 +216,13 @@ def test_kernels_build_and_agree_with_and_without_advanced_optimisation():
     assert (np.abs(ev["shape_turn"]) > 1e-6).all(), ev["shape_turn"]
     pos = np.asarray(on["periodic"]["position"])
     assert ((pos[:, 0] >= 0.0) & (pos[:, 0] < 0.2)).all()
-
+    # 3D: the shapes and the spheres in contact and turning, the periodic axis
+    for model in ("ellipsoids", "polyhedra"):
+        td = on[model]
+        assert td["contacts"] >= 3, model
+        assert (np.abs(td["shape_turn"]) > 1e-6).any(), (model, td["shape_turn"])
+        pos = np.asarray(td["position"])
+        assert ((pos[:, 0] >= 0.0) & (pos[:, 0] < 0.2)).all(), model
 
 if __name__ == "__main__":
     print("RESULT " + json.dumps(_state(int(sys.argv[1]) if len(sys.argv) > 1 else STEPS)))
