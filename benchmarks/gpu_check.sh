@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The CUDA check, in one go: the fast tests with TDEM_ARCH=gpu (one process per test
 # file, so that a file that breaks the CUDA context fails alone), then the DEM pack,
-# the PCMM column and the superellipse bed benchmarks on the GPU at large sizes.
+# the PCMM column, the superellipse bed and the 3D sphere pack benchmarks on the GPU
+# at large sizes.
 #
 #   bash benchmarks/gpu_check.sh [OUTDIR]
 #
@@ -10,6 +11,8 @@
 # Environment:
 #   SIDE      discs per row of the DEM pack and PCMM column (default 1000: 1M)
 #   SE_COLS   columns of the superellipse bed, 200 rows (default 1000: 200,000)
+#   SCALE3D   the 3D sphere pack's box widened in x and y by this factor (default
+#             21.25: 1.0M spheres, the 47,068 of benchmarks/pack3d.py times 21.25)
 #   TESTS     0 to skip the tests;  TEST_TIME  limit per test file in s (default 150)
 #   TEST_GLOB the test files (default tests/test_*.py)
 #   PROBE     0 to skip the first probe (small shaped and PCMM runs with Taichi's
@@ -52,6 +55,8 @@ if [ "${PROBE:-1}" != 0 ]; then
             --rows 20 --no-disc --warmup 200 --steps 200 &
         probe pcmm $opt python3 benchmarks/pcmm.py --arch "$ARCH" --side 60 --warmup 100 \
             --steps 100 --rounds 1 --no-dem &
+        probe ellipsoids $opt python3 benchmarks/pack3d.py --arch "$ARCH" --ellipsoids \
+            --scale 0.1 --warmup 100 --steps 100 &
     done
     wait
 fi | tee "$OUT/probes.txt"
@@ -78,3 +83,6 @@ timeout 120 python3 benchmarks/pcmm.py --arch "$ARCH" --side "$SIDE" --warmup 30
 echo "== superellipse bed, ${SE_COLS} x 200"
 timeout 80 python3 benchmarks/superellipse.py --arch "$ARCH" --cols "$SE_COLS" --no-disc \
     --warmup 500 --steps 500 2>&1 | tee "$OUT/superellipse.txt" | tail -12
+echo "== 3D sphere pack, ${SCALE3D:-21.25} x 47,068 spheres"
+timeout 200 python3 benchmarks/pack3d.py --arch "$ARCH" --scale "${SCALE3D:-21.25}" \
+    --warmup 300 --steps 1000 2>&1 | tee "$OUT/pack3d.txt" | tail -3
