@@ -101,10 +101,16 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
     # bodies whose bounding spheres are apart cannot touch: no penetration search
     # (except on a step that records every pair's gap for output)
     far = False
+    matj = ti.Matrix.zero(float, 3, 3)
     if ti.static(not detail):
         far = dist >= abci.max() + abcj.max()
     if not far:
         matj = shape_of_row(turn[j])
+        if ti.static(not detail):
+            # nor can bodies whose extents along the line of centres do not meet
+            # (h_i + h_j < |d| along d/|d|, h(u) = sqrt(uᵀ M u))
+            far = ti.sqrt(d.dot(mati @ d)) + ti.sqrt(d.dot(matj @ d)) < dist * dist
+    if not far:
         n0 = ti.Vector([h[NC], h[NC + 1], h[NC + 2]])
         if h[ST] <= 0.0 or n0.dot(d) <= 0.0:
             n0 = d / ti.max(dist, 1e-300)
@@ -114,7 +120,7 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
             ti.atomic_add(flags[F_NONCONV], 1)
     if status != 1 and u > 0.0:
         hi, pi = el.support(mati, n)
-        hj, pjo = el.support(shape_of_row(turn[j]), n)
+        hj, pjo = el.support(matj, n)
         c = 0.5 * (pi + d - pjo)            # from x_i; j's support point is x_j − M_j n/h_j
         ri_arm = c
         rj_arm = c - d
