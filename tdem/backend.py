@@ -100,8 +100,8 @@ def cfg_optimization():
     a kernel's whole body) runs: off unless ``$TDEM_CFG_OPTIMIZATION=1``. Its cost
     grows faster than the size of a kernel, and the step kernels of shaped particles
     are large: on 2 cores the first build of a model of ellipsoids took 135 s with it
-    and 18 s without, of polyhedra 143 s and 27 s, of superellipses 44 s and 6.5 s, of
-    spheres 46 s and 9.6 s. LLVM's own passes do most of its work afterwards: the
+    and 18 s without, of a cube 143 s and 15 s, of superellipses 44 s and 6.5 s, of
+    spheres 46 s and 10 s. LLVM's own passes do most of its work afterwards: the
     sphere and disc packs run as fast without it, ellipsoids and cubes 3–5 % slower
     (``benchmarks/RESULTS.md``)."""
     env = os.environ.get("TDEM_CFG_OPTIMIZATION", "")
