@@ -98,6 +98,10 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
     u = -1.0
     status = 1
     n = d * 0.0
+    hi = 1.0
+    hj = 1.0
+    pi = d * 0.0        # the support points' offsets from x_i and x_j
+    pjo = d * 0.0
     # bodies whose bounding spheres are apart cannot touch: no penetration search
     # (except on a step that records every pair's gap for output)
     far = False
@@ -115,12 +119,10 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
         if h[ST] <= 0.0 or n0.dot(d) <= 0.0:
             n0 = d / ti.max(dist, 1e-300)
         tol = 1e-10 * (abci.max() + abcj.max())
-        u, n, status = el.penetration(mati, matj, d, n0, tol, MAXIT)
+        u, n, status, hi, hj, pi, pjo = el.penetration(mati, matj, d, n0, tol, MAXIT)
         if status == 2:
             ti.atomic_add(flags[F_NONCONV], 1)
     if status != 1 and u > 0.0:
-        hi, pi = el.support(mati, n)
-        hj, pjo = el.support(matj, n)
         c = 0.5 * (pi + d - pjo)            # from x_i; j's support point is x_j − M_j n/h_j
         ri_arm = c
         rj_arm = c - d

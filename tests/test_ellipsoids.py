@@ -55,10 +55,14 @@ def test_penetration_depth_against_brute_force_and_symmetric():
             a = ti.Matrix([[mi[r, c] for c in ti.static(range(3))] for r in ti.static(range(3))])
             b = ti.Matrix([[mj[r, c] for c in ti.static(range(3))] for r in ti.static(range(3))])
             dv = ti.Vector([d[0], d[1], d[2]])
-            u, n, status = el.penetration(a, b, dv, dv.normalized(), 1e-13, 60)
+            u, n, status, hi, hj, oi, oj = el.penetration(a, b, dv, dv.normalized(), 1e-13, 60)
             out[0] = u
             out[1], out[2], out[3] = n[0], n[1], n[2]
             out[4] = status
+            out[5], out[6] = hi, hj
+            for c in ti.static(range(3)):
+                out[7 + c] = oi[c]
+                out[10 + c] = oj[c]
 
     rng = np.random.default_rng(7)
     for _ in range(6):
@@ -76,12 +80,17 @@ def test_penetration_depth_against_brute_force_and_symmetric():
             ref, nref = brute_depth(mi, mj, d)
             if ref > 0.0:
                 break
-        out = np.zeros(5)
+        out = np.zeros(13)
         depth(mi, mj, d, out)
         assert out[4] == 0
         assert out[0] == pytest.approx(ref, abs=1e-9 * dist)
         np.testing.assert_allclose(out[1:4], nref, atol=1e-5)
-        back = np.zeros(5)
+        # the support values and offsets at the returned normal come with it
+        n = out[1:4]
+        for h, off, m in ((out[5], out[7:10], mi), (out[6], out[10:13], mj)):
+            assert h == pytest.approx(math.sqrt(n @ m @ n), rel=1e-12)
+            np.testing.assert_allclose(off, m @ n / h, rtol=1e-12, atol=1e-15 * dist)
+        back = np.zeros(13)
         depth(mj, mi, -d, back)                       # i and j swapped
         assert back[0] == pytest.approx(out[0], rel=1e-10)
         np.testing.assert_allclose(back[1:4], -out[1:4], atol=1e-9)

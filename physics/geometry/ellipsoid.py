@@ -60,12 +60,18 @@ def tangent_basis(n):
 def penetration(mi, mj, d, n0, tol, maxit: ti.template()):
     """The penetration depth of two centrally symmetric convex bodies of shape
     matrices mi, mj at offset d = x_j − x_i (module docstring), from the unit
-    direction n0: (depth, n, status) with status 0 converged (|tangent gradient| <=
-    tol), 1 apart (a separating direction was met: depth < 0 there), 2 stopped at
-    ``maxit`` iterations."""
+    direction n0: (depth, n, status, h_i(n), h_j(n), M_i n/h_i, M_j n/h_j) with
+    status 0 converged (|tangent gradient| <= tol), 1 apart (a separating direction
+    was met: depth < 0 there), 2 stopped at ``maxit`` iterations. The support values
+    and offsets at the returned n are those of :func:`support` (the last iterate's,
+    not computed again)."""
     n = n0
     depth = 0.0
     status = 2
+    hi = 1.0
+    hj = 1.0
+    oi = n0 * 0.0
+    oj = n0 * 0.0
     for it in range(maxit):
         mni = mi @ n
         mnj = mj @ n
@@ -75,7 +81,9 @@ def penetration(mi, mj, d, n0, tol, maxit: ti.template()):
         if depth < 0.0:
             status = 1
             break
-        g = mni / hi + mnj / hj - d
+        oi = mni / hi
+        oj = mnj / hj
+        g = oi + oj - d
         t1, t2 = tangent_basis(n)
         g1 = t1.dot(g)
         g2 = t2.dot(g)
@@ -119,7 +127,11 @@ def penetration(mi, mj, d, n0, tol, maxit: ti.template()):
             s1 *= 0.5 / step
             s2 *= 0.5 / step
         n = (n + s1 * t1 + s2 * t2).normalized()
-    return depth, n, status
+    if status == 2:
+        # (the last step moved n after its support values were taken)
+        hi, oi = support(mi, n)
+        hj, oj = support(mj, n)
+    return depth, n, status, hi, hj, oi, oj
 
 
 @ti.func
