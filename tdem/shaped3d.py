@@ -10,7 +10,9 @@ that meets an ellipsoid takes part as the ellipsoid (r, r, r).
 The contact point c is the midpoint of the two support points; the moment on each
 body is (c − x) × f. The history of a pair holds, after the law's columns, the
 normal of the last step (the warm start) and the pair's state (> 0: touching, with
-the R* of its curvature radii). A contact whose iteration stops at the cap is
+the R* of its curvature radii; −1: apart, the normal columns holding the direction
+that separated them, where the next step's search starts: a pair that stays apart
+is then ruled out by one evaluation, not two or more). A contact whose iteration stops at the cap is
 counted in the status word (``flags[F_NONCONV]``, reported after the run).
 
 Against a mesh triangle (:func:`mesh_contact`): a face contact is exact — the
@@ -116,7 +118,7 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
             far = ti.sqrt(d.dot(mati @ d)) + ti.sqrt(d.dot(matj @ d)) < dist * dist
     if not far:
         n0 = ti.Vector([h[NC], h[NC + 1], h[NC + 2]])
-        if h[ST] <= 0.0 or n0.dot(d) <= 0.0:
+        if h[ST] == 0.0 or n0.dot(d) <= 0.0:
             n0 = d / ti.max(dist, 1e-300)
         tol = 1e-10 * (abci.max() + abcj.max())
         u, n, status, hi, hj, pi, pjo = el.penetration(mati, matj, d, n0, tol, MAXIT)
@@ -147,6 +149,17 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
         if ti.static(detail):
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, ft.norm(), u])
+    elif status == 1 and not far:
+        # apart along n: kept for the next step's start (written when it changed)
+        if h[ST] >= 0.0 or h[NC] != n[0] or h[NC + 1] != n[1] or h[NC + 2] != n[2]:
+            h = zero_history(h)
+            h[NC] = n[0]
+            h[NC + 1] = n[1]
+            h[NC + 2] = n[2]
+            h[ST] = -1.0
+            hist[i, k] = h
+        if ti.static(detail):
+            cs[i, k] = ti.Vector([0.0, 0.0, ti.min(u, 0.0)])
     else:
         if h[ST] != 0.0:
             hist[i, k] = zero_history(h)
