@@ -96,6 +96,50 @@ def test_penetration_depth_against_brute_force_and_symmetric():
         np.testing.assert_allclose(back[1:4], -out[1:4], atol=1e-9)
 
 
+def test_apart_pair_keeps_its_separating_direction_then_meets_at_the_true_depth():
+    """Two crossed ellipsoids whose extents along the line of centres overlap while
+    they are apart: the pair's history keeps a direction that separates them (the
+    next step's start, state -1), and when they meet the depth and normal found from
+    that start are the brute-force ones."""
+    abc = (0.02, 0.01, 0.005)
+    e = tdem.Ellipsoid(*abc)
+    hm = tdem.HertzMindlin(young=E, poisson=NU, friction=0.3)
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), progress=False)
+    d0 = np.array([0.018, 0.018, 0.007])
+    quarter = [math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4)]
+    sim.add_particles([[0.0, 0.0, 0.0], d0], shape=e, density=2500.0, contact=hm,
+                      orientation=[[1.0, 0.0, 0.0, 0.0], quarter],
+                      velocity=[[0.0, 0.0, 0.0], -0.2 * d0 / np.linalg.norm(d0)])
+    mi = shape_matrix([1.0, 0.0, 0.0, 0.0], abc)
+    mj = shape_matrix(quarter, abc)
+    u = d0 / np.linalg.norm(d0)
+    assert math.sqrt(u @ mi @ u) + math.sqrt(u @ mj @ u) > np.linalg.norm(d0)
+    assert brute_depth(mi, mj, d0)[0] < -5e-4
+    sim.run(steps=1)
+    hist = sim._a["hist"].to_numpy()[0, 0]           # (one pair: 0 owns slot 0)
+    assert sim._a["nbr"].to_numpy()[0, 0] == 1
+    n, state = hist[-4:-1], hist[-1]
+    assert state == -1.0 and np.linalg.norm(n) == pytest.approx(1.0, abs=1e-12)
+    d = np.diff(sim.particles.numpy()["position"], axis=0)[0]
+    assert math.sqrt(n @ mi @ n) + math.sqrt(n @ mj @ n) - d @ n < 0.0
+    assert not hist[:-4].any()                       # the law's columns stay zero
+    # the contacts a step reports are those at its start: the state before it
+    s = sim.particles.numpy()
+    for _ in range(2000):
+        s = sim.particles.numpy()
+        sim.run(steps=1)
+        c = sim.contacts.numpy()
+        if len(c["pairs"]):
+            break
+    assert len(c["pairs"]) == 1
+    mi = shape_matrix(s["orientation"][0], abc)
+    mj = shape_matrix(s["orientation"][1], abc)
+    ref, nref = brute_depth(mi, mj, s["position"][1] - s["position"][0])
+    assert c["overlap"][0] == pytest.approx(ref, abs=1e-9 * abc[0])
+    np.testing.assert_allclose(c["direction"][0], nref, atol=1e-5)
+    assert sim.nonconverged_contacts == 0
+
+
 def _spinning(w0, per_turn, abc=(0.03, 0.02, 0.01), rho=1000.0):
     e = tdem.Ellipsoid(*abc)
     sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), progress=False, check_interval=2000)
