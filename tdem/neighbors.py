@@ -288,7 +288,7 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
     # 6.-8. reverse lists, the mesh triangles' bins, candidate walls
     finish_build(pos, prop, nbr, ncnt, rev, rcnt, gridp, gridn, flags, wall, wid, whist,
                  wid_old, whist_old, nwalls, skin, tbin_count, tbin_start, tbin_items, ncell,
-                 nx, nrows, dim)
+                 nx, nrows, dim, per)
 
 
 @ti.func
@@ -298,11 +298,18 @@ def finish_build(pos: ti.template(), prop: ti.template(), nbr: ti.template(),
                  wall: ti.template(), wid: ti.template(), whist: ti.template(),
                  wid_old: ti.template(), whist_old: ti.template(), nwalls, skin,
                  tbin_count: ti.template(), tbin_start: ti.template(),
-                 tbin_items: ti.template(), ncell, nx, nrows, dim: ti.template()):
+                 tbin_items: ti.template(), ncell, nx, nrows, dim: ti.template(), per):
     """The part of a list build that follows the half lists, whichever broad phase made
     them (this grid's or :mod:`tdem.sweep`): the reverse lists, the mesh triangles'
     bins (3D), each particle's candidate walls; then the flag lowered. ``rcnt`` must
-    be zero on entry."""
+    be zero on entry. ``per``: the periodic axes (:func:`periodic_axes`).
+
+    Walls are not periodic: a particle that crosses a periodic side before the next
+    build is put back by a period, among other walls than those near where it was.
+    So a particle within a skin of a periodic side also takes the walls near its
+    image across that side (and across both sides at a corner): its candidates are
+    then right on either side of the crossing (those of the side it is not on lie
+    farther than its reach)."""
     n = pos.shape[0]
     cap = nbr.shape[1]
     # 6. reverse lists (who names me), then sorted for a fixed summation order
@@ -331,46 +338,74 @@ def finish_build(pos: ti.template(), prop: ti.template(), nbr: ti.template(),
         bin_triangles(wall, nwalls, gridp, gridn, ncell, nx, nrows, flags, tbin_count,
                       tbin_start, tbin_items)
     # 8. candidate walls (within R + skin), sorted by wall index, history carried over:
-    #    in 3D the triangles of the particle's cell (all of them if the bins overflowed)
+    #    in 3D the triangles of the particle's cell (all of them if the bins overflowed);
+    #    near a periodic side, also those of its image across it (docstring)
     for i in range(n):
         if flags[F_REBUILD] != 0:
             capw = wid.shape[1]
             for s in range(capw):
                 wid_old[i, s] = wid[i, s]
                 whist_old[i, s] = whist[i, s]
-            xi = pos[i]
             cut = prop[i][PROP_RADIUS] + skin
             cnt = 0
-            first = 0
-            last = nwalls
             binned = False
             if ti.static(dim == 3):
                 binned = flags[F_TBIN_TOTAL] <= tbin_items.shape[0]
-                if binned:
-                    c = cell_index(cell_of(xi, gridp, gridn), gridn)
-                    first = tbin_start[c]
-                    last = first + tbin_count[c]
-            for e in range(first, last):
-                w = e
-                if ti.static(dim == 3):
-                    if binned:
-                        w = tbin_items[e]
-                d = wall_offset(wall, w, xi)
-                if d.dot(d) < cut * cut:
-                    if cnt < capw:
-                        h = zero_history(whist[i, 0])
-                        for s in range(capw):
-                            if wid_old[i, s] == w:
-                                h = whist_old[i, s]
-                        # insertion by wall index (a fixed order whatever the bins')
-                        k = cnt
-                        while k > 0 and wid[i, k - 1] > w:
-                            wid[i, k] = wid[i, k - 1]
-                            whist[i, k] = whist[i, k - 1]
-                            k -= 1
-                        wid[i, k] = w
-                        whist[i, k] = h
-                    cnt += 1
+            # the images: a digit per axis, 0 here, 1 one period up, 2 one period down
+            for img in range(3 ** dim):
+                xi = pos[i]
+                use = True
+                code = img
+                for ax in ti.static(range(dim)):
+                    digit = code % 3
+                    code //= 3
+                    if digit != 0:
+                        x0 = per[2 * ax]
+                        span = per[2 * ax + 1]
+                        if span <= 0.0:
+                            use = False
+                        elif digit == 1:
+                            use = use and xi[ax] - x0 < skin
+                            xi[ax] += span
+                        else:
+                            use = use and x0 + span - xi[ax] < skin
+                            xi[ax] -= span
+                if use:
+                    first = 0
+                    last = nwalls
+                    if ti.static(dim == 3):
+                        if binned:
+                            c = cell_index(cell_of(xi, gridp, gridn), gridn)
+                            first = tbin_start[c]
+                            last = first + tbin_count[c]
+                    for e in range(first, last):
+                        w = e
+                        if ti.static(dim == 3):
+                            if binned:
+                                w = tbin_items[e]
+                        d = wall_offset(wall, w, xi)
+                        if d.dot(d) < cut * cut:
+                            listed = False
+                            if img != 0:       # (a wall near both positions: once)
+                                for s in range(ti.min(cnt, capw)):
+                                    if wid[i, s] == w:
+                                        listed = True
+                            if not listed:
+                                if cnt < capw:
+                                    h = zero_history(whist[i, 0])
+                                    for s in range(capw):
+                                        if wid_old[i, s] == w:
+                                            h = whist_old[i, s]
+                                    # insertion by wall index (a fixed order whatever
+                                    # the bins')
+                                    k = cnt
+                                    while k > 0 and wid[i, k - 1] > w:
+                                        wid[i, k] = wid[i, k - 1]
+                                        whist[i, k] = whist[i, k - 1]
+                                        k -= 1
+                                    wid[i, k] = w
+                                    whist[i, k] = h
+                                cnt += 1
             ti.atomic_max(flags[F_WALL_NEED], cnt)
             for s in range(cnt, capw):
                 wid[i, s] = -1

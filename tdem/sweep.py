@@ -203,4 +203,4 @@ def rebuild(pos: ti.types.ndarray(), prop: ti.types.ndarray(), xref: ti.types.nd
     # 5. reverse lists, candidate walls: as after the grid's build
     finish_build(pos, prop, nbr, ncnt, rev, rcnt, gridp, gridn, flags, wall, wid, whist,
                  wid_old, whist_old, nwalls, skin, tbin_count, tbin_start, tbin_items, ncell,
-                 nx, nrows, dim)
+                 nx, nrows, dim, ti.Vector([0.0 for _ in ti.static(range(2 * dim))]))

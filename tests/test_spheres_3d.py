@@ -369,3 +369,33 @@ def test_triangle_bins_give_the_same_run_as_every_triangle():
     np.testing.assert_array_equal(fa.force, fb.force)
     n = a.n_particles
     assert -fa.force[2] == pytest.approx(n * mass(0.005) * 9.81, rel=0.5)     # on the floor
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_sphere_crossing_a_periodic_side_keeps_its_mesh_floor(axis):
+    """Walls are not periodic: a sphere that slides across a periodic side comes back
+    over other triangles of the floor, which its candidate walls must already hold
+    (those of its image, tdem.neighbors.finish_build). Its weight stays on the floor
+    at every step, before and after the crossing, at the Hertz rest height."""
+    L = 0.1
+    hm = tdem.HertzMindlin(young=E, poisson=NU, friction=0.0)
+    sim = tdem.Simulation(dim=3, progress=False)
+    sim.periodic(x=(0.0, L), y=(0.0, L))
+    verts, tris = tdem.surfaces.plane((0.5 * L, 0.5 * L, 0.0), (0.0, 0.0, 1.0), L + 0.04, 2)
+    floor = sim.add_mesh(verts, tris, contact=hm)
+    weight = mass() * 9.81
+    delta = (3.0 * weight / (4.0 * e_star() * math.sqrt(R))) ** (2.0 / 3.0)
+    x = [0.5 * L, 0.5 * L, R - delta]
+    x[axis] = L - 0.05 * R
+    v = [0.0, 0.0, 0.0]
+    v[axis] = 0.05
+    sim.add_particles([x], R, density=RHO, contact=hm, velocity=[v])
+    steps = int(0.03 / sim.dt)
+    vals = record(sim, lambda s: [s.particles.numpy()["position"][0, axis],
+                                  s.particles.numpy()["position"][0, 2], -floor.force[2]],
+                  steps)
+    crossed = np.flatnonzero(vals[:, 0] < 0.5 * L)
+    assert len(crossed) > steps // 2                   # it went across early on
+    assert vals[-1, 0] == pytest.approx(0.05 * 0.03 - 0.05 * R, abs=1e-4)
+    np.testing.assert_allclose(vals[:, 2], weight, rtol=0.05)
+    np.testing.assert_allclose(vals[:, 1], R - delta, atol=0.1 * delta)
