@@ -153,10 +153,32 @@ def test_small_heaps_rest_on_the_base_and_carry_their_weight(heaps):
 
 
 def test_small_heaps_have_an_angle_on_both_flanks(heaps):
+    """Each flank is fitted, at an angle between 5° and 60°, unless it is a steep edge
+    too short for the fit's three bins within 20–80 % of the heap's height: a
+    150-grain heap of irregular grains can end its flat top that way (one 1 cm bin
+    from above the band to below its middle; which heap does depends on round-off).
+    Such a flank is checked to be one, steeper than 30° from its last bin above the
+    band to its outermost bin, and at least one flank of each heap is fitted."""
     for name, r in heaps.items():
+        fitted = 0
         for side in ("left", "right"):
             a = r["fit"][side]["angle"]
-            assert a is not None and 5.0 < a < 60.0, (name, side, a)
+            if a is not None:
+                assert 5.0 < a < 60.0, (name, side, a)
+                fitted += 1
+                continue
+            x = np.asarray(r["profile_x"])
+            h = np.asarray(r["profile_h"])
+            top = r["fit"]["height"]
+            out = x > r["fit"]["apex_x"] if side == "right" else x < r["fit"]["apex_x"]
+            order = np.argsort(np.abs(x[out] - r["fit"]["apex_x"]))
+            xs, hs = x[out][order], h[out][order]
+            above = np.flatnonzero(hs > ar.FIT_BAND[1] * top)
+            assert len(above) and above[-1] < len(xs) - 1, (name, side)
+            edge = math.degrees(math.atan((hs[above[-1]] - hs[-1])
+                                          / abs(xs[-1] - xs[above[-1]])))
+            assert edge > 30.0, (name, side, edge)
+        assert fitted >= 1, name
 
 
 def test_summary_schema_of_a_finished_run(heaps, tmp_path):
