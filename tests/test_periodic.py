@@ -15,6 +15,8 @@
 - Bad periods are refused, naming the argument.
 - A periodic pack carries its lid's stress across the boundary (Love–Weber), and a
   sheared periodic crystal carries the platen stresses of a wider walled one.
+- A disc that slides across the periodic side stays on a floor of two segments (the
+  walls are not periodic: its candidate walls hold those near its image).
 """
 
 import math
@@ -307,3 +309,29 @@ def test_a_sheared_periodic_column_carries_the_wall_stresses_of_a_wider_walled_o
     # (measured: both within 3e-4; a tighter bound keeps the claim above honest)
     assert syy_w == pytest.approx(syy_p, rel=1e-3)
     assert sxy_w == pytest.approx(sxy_p, rel=1e-3)
+
+
+def test_a_disc_crossing_the_periodic_side_stays_on_a_floor_of_two_segments():
+    """Walls are not periodic: a disc sliding across the periodic side comes back over
+    the other segment of the floor, which its candidate walls must already hold (the
+    walls near its image, tdem.neighbors.finish_build). The floor carries its weight
+    at every step, at the rest overlap m g / k_n."""
+    L, r, rho = 0.1, 0.005, 2500.0
+    lin = tdem.LinearContact(kn=KN, ks=0.0, friction=0.0)
+    sim = tdem.Simulation(gravity=(0.0, -9.81), progress=False)
+    sim.periodic(x=(0.0, L))
+    left = sim.add_wall((-0.02, 0.0), (0.05, 0.0), contact=lin)
+    right = sim.add_wall((0.05, 0.0), (L + 0.02, 0.0), contact=lin)
+    weight = rho * math.pi * r * r * 9.81
+    delta = weight / KN
+    sim.add_particles([[L - 0.05 * r, r - delta]], r, density=rho, contact=lin,
+                      velocity=[[0.05, 0.0]])
+    steps = int(0.03 / sim.dt)
+    sim.monitor("probe", lambda s: [s.particles.numpy()["position"][0, 0],
+                                    s.particles.numpy()["position"][0, 1],
+                                    left.force[1] + right.force[1]], every=1)
+    sim.run(steps=steps)
+    vals = np.asarray(sim.histories()["probe"][1])
+    assert np.count_nonzero(vals[:, 0] < 0.5 * L) > steps // 2     # it went across
+    np.testing.assert_allclose(-vals[:, 2], weight, rtol=0.05)
+    np.testing.assert_allclose(vals[:, 1], r - delta, atol=0.1 * delta)
