@@ -351,61 +351,12 @@ def finish_build(pos: ti.template(), prop: ti.template(), nbr: ti.template(),
             binned = False
             if ti.static(dim == 3):
                 binned = flags[F_TBIN_TOTAL] <= tbin_items.shape[0]
-            # the images: a digit per axis, 0 here, 1 one period up, 2 one period down
             for img in range(3 ** dim):
-                xi = pos[i]
-                use = True
-                code = img
-                for ax in ti.static(range(dim)):
-                    digit = code % 3
-                    code //= 3
-                    if digit != 0:
-                        x0 = per[2 * ax]
-                        span = per[2 * ax + 1]
-                        if span <= 0.0:
-                            use = False
-                        elif digit == 1:
-                            use = use and xi[ax] - x0 < skin
-                            xi[ax] += span
-                        else:
-                            use = use and x0 + span - xi[ax] < skin
-                            xi[ax] -= span
+                use, xi = periodic_image(pos[i], img, per, skin)
                 if use:
-                    first = 0
-                    last = nwalls
-                    if ti.static(dim == 3):
-                        if binned:
-                            c = cell_index(cell_of(xi, gridp, gridn), gridn)
-                            first = tbin_start[c]
-                            last = first + tbin_count[c]
-                    for e in range(first, last):
-                        w = e
-                        if ti.static(dim == 3):
-                            if binned:
-                                w = tbin_items[e]
-                        d = wall_offset(wall, w, xi)
-                        if d.dot(d) < cut * cut:
-                            listed = False
-                            if img != 0:       # (a wall near both positions: once)
-                                for s in range(ti.min(cnt, capw)):
-                                    if wid[i, s] == w:
-                                        listed = True
-                            if not listed:
-                                if cnt < capw:
-                                    h = zero_history(whist[i, 0])
-                                    for s in range(capw):
-                                        if wid_old[i, s] == w:
-                                            h = whist_old[i, s]
-                                    # insertion by wall index (a fixed order whatever
-                                    # the bins')
-                                    k = cnt
-                                    while k > 0 and wid[i, k - 1] > w:
-                                        wid[i, k] = wid[i, k - 1]
-                                        whist[i, k] = whist[i, k - 1]
-                                        k -= 1
-                                    wid[i, k] = w
-                                    whist[i, k] = h
-                                cnt += 1
+                    cnt = list_walls_near(i, xi, cut, cnt, img != 0, wall, wid, whist,
+                                          wid_old, whist_old, nwalls, binned, gridp, gridn,
+                                          tbin_start, tbin_count, tbin_items)
             ti.atomic_max(flags[F_WALL_NEED], cnt)
             for s in range(cnt, capw):
                 wid[i, s] = -1
@@ -421,6 +372,79 @@ def finish_build(pos: ti.template(), prop: ti.template(), nbr: ti.template(),
             flags[F_REBUILD] = 0
 
 
+
+
+@ti.func
+def periodic_image(x, img, per, margin):
+    """Image ``img`` of point x (a base-3 digit per axis: 0 x itself, 1 one period up,
+    2 one period down) and whether it is wanted: every shifted axis periodic and x
+    within ``margin`` of the side it would cross to get there."""
+    use = True
+    code = img
+    for ax in ti.static(range(x.n)):
+        digit = code % 3
+        code //= 3
+        if digit != 0:
+            x0 = per[2 * ax]
+            span = per[2 * ax + 1]
+            if span <= 0.0:
+                use = False
+            elif digit == 1:
+                use = use and x[ax] - x0 < margin
+                x[ax] += span
+            else:
+                use = use and x0 + span - x[ax] < margin
+                x[ax] -= span
+    return use, x
+
+
+@ti.func
+def list_walls_near(i, xi, cut, cnt, dedupe, wall: ti.template(), wid: ti.template(),
+                    whist: ti.template(), wid_old: ti.template(), whist_old: ti.template(),
+                    nwalls, binned, gridp: ti.template(), gridn: ti.template(),
+                    tbin_start: ti.template(), tbin_count: ti.template(),
+                    tbin_items: ti.template()):
+    """Add to particle i's candidate walls (``cnt`` listed so far) those within
+    ``cut`` of the point xi, in wall order, each with its history of the last list;
+    in 3D from the triangles binned in xi's cell when ``binned``. ``dedupe``: skip
+    walls already listed (a second point of the same particle). Returns the count,
+    which goes on past the slots when they are short (the host then grows them)."""
+    capw = wid.shape[1]
+    first = 0
+    last = nwalls
+    if ti.static(xi.n == 3):
+        if binned:
+            c = cell_index(cell_of(xi, gridp, gridn), gridn)
+            first = tbin_start[c]
+            last = first + tbin_count[c]
+    for e in range(first, last):
+        w = e
+        if ti.static(xi.n == 3):
+            if binned:
+                w = tbin_items[e]
+        d = wall_offset(wall, w, xi)
+        if d.dot(d) < cut * cut:
+            listed = False
+            if dedupe:
+                for s in range(ti.min(cnt, capw)):
+                    if wid[i, s] == w:
+                        listed = True
+            if not listed:
+                if cnt < capw:
+                    h = zero_history(whist[i, 0])
+                    for s in range(capw):
+                        if wid_old[i, s] == w:
+                            h = whist_old[i, s]
+                    # insertion by wall index (a fixed order whatever the bins')
+                    k = cnt
+                    while k > 0 and wid[i, k - 1] > w:
+                        wid[i, k] = wid[i, k - 1]
+                        whist[i, k] = whist[i, k - 1]
+                        k -= 1
+                    wid[i, k] = w
+                    whist[i, k] = h
+                cnt += 1
+    return cnt
 
 
 @ti.func

@@ -12,8 +12,9 @@ body is (c − x) × f. The history of a pair holds, after the law's columns, th
 normal of the last step (the warm start) and the pair's state (> 0: touching, with
 the R* of its curvature radii; −1: apart, the normal columns holding the direction
 that separated them, where the next step's search starts: a pair that stays apart
-is then ruled out by one evaluation, not two or more). A contact whose iteration stops at the cap is
-counted in the status word (``flags[F_NONCONV]``, reported after the run).
+is then ruled out by one evaluation, not two or more). A contact whose iteration
+stops at the cap is counted in the status word (``flags[F_NONCONV]``, reported after
+the run).
 
 Against a mesh triangle (:func:`mesh_contact`): a face contact is exact — the
 ellipsoid's deepest point towards the triangle's plane, x − M N/h(N) with N the
