@@ -128,7 +128,7 @@ def poly_pair(i, k, xi, vi, wi, mi, li, pos: ti.template(), vel: ti.template(),
               angle: ti.template(), shp: ti.template(), lawp: ti.template(),
               lawpair: ti.template(), nbr: ti.template(), hist: ti.template(),
               cn: ti.template(), cs: ti.template(), flags: ti.template(), dt,
-              detail: ti.template(), laws: ti.template(), per, ptab: ti.template(),
+              detail, laws: ti.template(), per, ptab: ti.template(),
               pint: ti.template()):
     """Contact in slot k of particle i (the owner) when either body is a polyhedron;
     returns (f_i, M_i, M_j, dissipated energy), as :func:`tdem.step.pair_contact`."""
@@ -214,13 +214,13 @@ def poly_pair(i, k, xi, vi, wi, mi, li, pos: ti.template(), vel: ti.template(),
             h[R + q] = c[q]              # the contact point from x_i (output)
         h[ST] = lc
         hist[i, k] = h
-        if ti.static(detail):
+        if detail:
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, ft.norm(), u])
     else:
         if h[ST] != 0.0:
             hist[i, k] = zero_history(h)
-        if ti.static(detail):
+        if detail:
             cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
     return f, m_on_i, m_on_j, diss
 

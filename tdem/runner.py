@@ -633,7 +633,7 @@ class Runner:
             cont.point_edge(self, dt)
             cont.viscous_boundaries(self)
         if self._n:
-            stepk.step(*step_args, detail, cont is not None and cont.adds_forces, self._law_set,
+            stepk.step(*step_args, int(detail), cont is not None and cont.adds_forces, self._law_set,
                        self._shape_code, self.dim)
         if cont is not None:
             cont.integrate(self)

@@ -42,7 +42,7 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, ci, sni, shi, rbi, pos: ti.template(),
                 plaw: ti.template(), turn: ti.template(), shp: ti.template(),
                 lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                 hist: ti.template(), cn: ti.template(), cs: ti.template(),
-                flags: ti.template(), dt, detail: ti.template(), laws: ti.template(), per):
+                flags: ti.template(), dt, detail, laws: ti.template(), per):
     """Contact in slot k of particle i (the owner) when either body has a shape
     (``ci``, ``sni``: the cosine and sine of i's angle; ``turn``: those of every
     particle); returns (f_i, M_i, M_j,
@@ -108,7 +108,7 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, ci, sni, shi, rbi, pos: ti.template(),
             h[PHI] = phi
             h[ST] = reff
             diss = d1
-            if ti.static(detail):
+            if detail:
                 cn[i, k] = n
                 cs[i, k] = ti.Vector([fn, ft[0], delta])
         else:
@@ -116,7 +116,7 @@ def shaped_pair(i, k, xi, vi, wi, mi, li, ci, sni, shi, rbi, pos: ti.template(),
             h[PHI] = phi
             h[ST] = -1.0
         hist[i, k] = h
-    if ti.static(detail):
+    if detail:
         if u_out <= 0.0:
             cs[i, k] = ti.Vector([0.0, 0.0, u_out])
     return f, m_on_i, m_on_j, diss

@@ -78,7 +78,7 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
                    plaw: ti.template(), turn: ti.template(), shp: ti.template(),
                    lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                    hist: ti.template(), cn: ti.template(), cs: ti.template(),
-                   flags: ti.template(), dt, detail: ti.template(), laws: ti.template(),
+                   flags: ti.template(), dt, detail, laws: ti.template(),
                    per):
     """Contact in slot k of particle i (the owner) when either body is an ellipsoid
     (``mati``: i's shape matrix, ``abci`` its semi-axes; ``turn`` every particle's
@@ -105,27 +105,30 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
     hj = 1.0
     pi = d * 0.0        # the support points' offsets from x_i and x_j
     pjo = d * 0.0
-    # bodies whose bounding spheres are apart cannot touch: no penetration search
-    # (except on a step that records every pair's gap for output)
-    far = False
+    # bodies whose bounding spheres are apart cannot touch: no penetration search.
+    # A step that records every pair's gap for output searches them too, but treats
+    # their history as any other step does (a search's direction kept from an output
+    # step would start the next search elsewhere: results would depend, at round-off,
+    # on where a run was cut into segments)
+    far = dist >= abci.max() + abcj.max()
+    search = not far or detail != 0
     matj = ti.Matrix.zero(float, 3, 3)
-    if ti.static(not detail):
-        far = dist >= abci.max() + abcj.max()
-    if not far:
+    if search:
         matj = shape_of_row(turn[j])
-        if ti.static(not detail):
+        if not far:
             # nor can bodies whose extents along the line of centres do not meet
             # (h_i + h_j < |d| along d/|d|, h(u) = sqrt(uᵀ M u))
             far = ti.sqrt(d.dot(mati @ d)) + ti.sqrt(d.dot(matj @ d)) < dist * dist
-    if not far:
+            search = not far or detail != 0
+    if search:
         n0 = ti.Vector([h[NC], h[NC + 1], h[NC + 2]])
         if h[ST] == 0.0 or n0.dot(d) <= 0.0:
             n0 = d / ti.max(dist, 1e-300)
         tol = 1e-10 * (abci.max() + abcj.max())
         u, n, status, hi, hj, pi, pjo = el.penetration(mati, matj, d, n0, tol, MAXIT)
-        if status == 2:
+        if status == 2 and not far:
             ti.atomic_add(flags[F_NONCONV], 1)
-    if status != 1 and u > 0.0:
+    if status != 1 and u > 0.0 and not far:
         c = 0.5 * (pi + d - pjo)            # from x_i; j's support point is x_j − M_j n/h_j
         ri_arm = c
         rj_arm = c - d
@@ -147,7 +150,7 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
         h[NC + 2] = n[2]
         h[ST] = reff
         hist[i, k] = h
-        if ti.static(detail):
+        if detail:
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, ft.norm(), u])
     elif status == 1 and not far:
@@ -159,12 +162,12 @@ def ellipsoid_pair(i, k, xi, vi, wi, mi, li, mati, abci, pos: ti.template(),
             h[NC + 2] = n[2]
             h[ST] = -1.0
             hist[i, k] = h
-        if ti.static(detail):
+        if detail:
             cs[i, k] = ti.Vector([0.0, 0.0, ti.min(u, 0.0)])
     else:
         if h[ST] != 0.0:
             hist[i, k] = zero_history(h)
-        if ti.static(detail):
+        if detail:
             cs[i, k] = ti.Vector([0.0, 0.0, ti.min(u, 0.0)])
     return f, m_on_i, m_on_j, diss
 

@@ -64,7 +64,7 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
                  omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                  lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                  hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-                 detail: ti.template(), laws: ti.template(), per):
+                 detail, laws: ti.template(), per):
     """Contact in slot k of particle i (the owner, i < j) with partner j = nbr[i, k]:
     two discs (:func:`disc_pair`) or two spheres (:func:`sphere_pair`). xi, vi, wi,
     ri, mi, li are i's position, velocity, spin, radius, mass and law group; ``laws``
@@ -94,7 +94,7 @@ def sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templa
                 omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                 lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                 hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-                detail: ti.template(), laws: ti.template(), per):
+                detail, laws: ti.template(), per):
     """:func:`pair_contact` of two spheres. The pair is tested on the squared distance
     first: of the listed pairs of a dense bed a third or more do not touch, and those
     cost a load of the partner's position and radius and no square root. The history
@@ -149,14 +149,14 @@ def sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templa
             m_on_j -= m_tot
             diss += d2
         hist[i, k] = h
-        if ti.static(detail):
+        if detail:
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, ft.norm(), u])
     else:
         h = hist[i, k]
         if h.dot(h) != 0.0:
             hist[i, k] = zero_history(h)
-        if ti.static(detail):
+        if detail:
             cs[i, k] = ti.Vector([0.0, 0.0, rs - ti.sqrt(r2)])
     return f, m_on_i, m_on_j, diss
 
@@ -166,7 +166,7 @@ def disc_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template
               omega: ti.template(), prop: ti.template(), plaw: ti.template(),
               lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
               hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-              detail: ti.template(), laws: ti.template(), per):
+              detail, laws: ti.template(), per):
     """:func:`pair_contact` of two discs. The history vector holds the law's columns,
     the rolling couple, rotation and broken flag (from column R) and the overlap
     offset u0 (the last column)."""
@@ -211,14 +211,14 @@ def disc_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template
         diss = d1 + d2
         h[U0] = u0
         hist[i, k] = h
-        if ti.static(detail):
+        if detail:
             cn[i, k] = n
             cs[i, k] = ti.Vector([fn, fs_tot, u])
     else:
         h = zero_history(h)
         h[U0] = u0
         hist[i, k] = h
-        if ti.static(detail):
+        if detail:
             cs[i, k] = ti.Vector([0.0, 0.0, u])
     return f, m_on_i, m_on_j, diss
 
@@ -503,12 +503,15 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          fext: ti.types.ndarray(), lmom: ti.types.ndarray(), ptab: ti.types.ndarray(),
          pint: ti.types.ndarray(), serial: ti.template(), chunk: ti.template(),
          loads: ti.template(),
-         detail: ti.template(), continuum: ti.template(), laws: ti.template(),
+         detail: ti.i32, continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
-    """One step. ``detail`` (a compile-time switch) also stores what only output
-    reads: per-contact normals, scalar forces and overlaps, particle forces, and
-    the kinetic and gravitational energy at t_n. The host asks for it on the last
-    step before anything looks at the state.
+    """One step. ``detail`` (1 or 0) also stores what only output reads: per-contact
+    normals, scalar forces and overlaps, particle forces, and the kinetic and
+    gravitational energy at t_n. The host asks for it on the last step before
+    anything looks at the state. It is a value, not a compile-time switch: every step
+    runs the same machine code, so that a run's numbers do not depend on where it was
+    cut into segments (two compiled variants of the step round differently under
+    fast math, and a segment's last step is a detail step).
 
     ``continuum`` (compile-time): PCMM particles are present. Their element forces
     of this step (``xforce``, from :func:`physics.pcmm.update`) join the contact
@@ -614,7 +617,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if skip == 1:
                     # the elements carry this pair (its history is kept by
                     # physics.pcmm.gather)
-                    if ti.static(detail):
+                    if detail:
                         cs[i, k] = ti.Vector([0.0, 0.0, 0.0])
                 else:
                     if ti.static(continuum):
@@ -677,9 +680,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                         j = nbr[i, k]
                         if j < end:
                             facc[j] = facc[j] + pack(-fk, mjk, dim)
-                        elif ti.static(not detail):
+                        elif not detail:
                             cf[i, k] = pack(fk, mjk, dim)
-                if ti.static(detail):
+                if detail:
                     cf[i, k] = pack(fk, mjk, dim)
                 elif ti.static(not serial and not chunk):
                     if skip != 1:      # (a carried pair's share is not read, see 2.)
@@ -819,7 +822,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             ework[i][3] += w_damp
             ework[i][4] += w_fix
             eacc[i] += ti.Vector([-w_damp, w_fix])
-        if ti.static(detail):
+        if detail:
             force[i] = fc + fx_cont
             torque[i] = tc
             rot_ke = 0.5 * inertia * spin_dot(wm, wm, dim)
