@@ -133,9 +133,9 @@ class Simulation(Runner, Results):
     progress : None (a bar on a terminal for runs over 2 s), True or False
     threads : CPU threads (process-wide; None: Taichi's default or ``$TDEM_THREADS``)
     dim : 2 or 3. In 3D the particles are spheres (positions, velocities and spins
-        are 3-vectors, orientations unit quaternions) and the walls triangle meshes
-        (:meth:`add_mesh`); PCMM bodies, blocks, segment walls, superellipses and
-        rolling resistance are 2D.
+        are 3-vectors, orientations unit quaternions), ellipsoids or polyhedra, and
+        the walls triangle meshes (:meth:`add_mesh`); PCMM bodies, blocks, segment
+        walls and superellipses are 2D; rolling resistance is for discs and spheres.
     broad_phase : "grid" (a cell grid over bounding spheres, :mod:`tdem.neighbors`) or
         "sweep" (incremental sort-and-sweep of bounding boxes, :mod:`tdem.sweep`; not
         with periodic axes, PCMM bodies or blocks). Both list every pair within
@@ -848,9 +848,9 @@ class Simulation(Runner, Results):
         """In 3D, refuse the arguments of 2D-only features, naming the first given."""
         for name, v in given.items():
             if v is not None:
-                raise InputError(f"{name}: a 2D feature (PCMM bodies, blocks, superellipses, "
-                                 f"segment walls and rolling resistance are 2D); a 3D "
-                                 f"simulation takes spheres and mesh walls (got {name}={v!r})")
+                raise InputError(f"{name}: a 2D feature (PCMM bodies, blocks, superellipses "
+                                 f"and segment walls are 2D); a 3D simulation takes spheres, "
+                                 f"ellipsoids, polyhedra and mesh walls (got {name}={v!r})")
 
     @property
     def walls(self):
