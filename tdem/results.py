@@ -304,8 +304,10 @@ class Results:
         """Work account (J per metre of thickness) since the bodies were added: the
         work each force did, booked at every step as F·(v_{n−1/2} + v_{n+1/2})/2·Δt
         (moments likewise with the spins). For the leapfrog this sums exactly to the
-        change of the kinetic energy at the half steps, ½ m v_{n+1/2}², so
-        ``residual`` (kinetic_change − total) is round-off.
+        change of the kinetic energy at the half steps, ½ m v_{n+1/2}² (and ½ ω·L of
+        the rotation), so ``residual`` (kinetic_change − total) is round-off; for
+        bodies whose spin is not along their angular momentum (tumbling ellipsoids)
+        it is the rotation splitting's error, which falls with the time step.
 
         kinetic_change; contacts (particle pairs and walls); continuum (PCMM elements,
         point–edge contacts and non-reflecting boundaries on particles, the nodal
@@ -352,8 +354,13 @@ class Results:
             e["Wp_damping"], e["Wp_constraints"] = float(ws[3]), float(ws[4])
             e["ke_start"] = float(ws[6])
             w2 = w * w if w.ndim == 1 else np.einsum("ij,ij->i", w, w)
-            e["ke_half"] = float(0.5 * np.sum(prop[:, 1] * np.einsum("ij,ij->i", v, v)
-                                              + prop[:, 2] * w2))
+            iw2 = prop[:, 2] * w2
+            if self.dim == 3 and self._has_shapes:
+                # ellipsoids and polyhedra: ω·L, L the angular momentum at the half step
+                # (I ω² with the scalar inertia of prop is a sphere's)
+                turned = a["shp"].to_numpy()[:, 3] != 0.0
+                iw2[turned] = np.einsum("ij,ij->i", w[turned], a["lmom"].to_numpy()[turned])
+            e["ke_half"] = float(0.5 * np.sum(prop[:, 1] * np.einsum("ij,ij->i", v, v) + iw2))
             # ½ Δt F_n·v_{n+1/2} of the contact and element forces of the last step:
             # the half step by which the booked work runs ahead of the stored energy
             f = a["force"].to_numpy()

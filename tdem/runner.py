@@ -511,17 +511,37 @@ class Runner:
         t = self._time if t is None else t
         ext = np.zeros((self._n, 3 if self.dim == 2 else 6))
         any_fn = False
+        # the columns of fx, fy, moment (2D) or fx, fy, fz, moment (3D: a 3-vector)
+        cols = (0, 1, 2) if self.dim == 2 else (0, 1, 2, slice(3, 6))
         for ids, *vals in self._loads:
-            for col, v in enumerate(vals):
+            for col, v in zip(cols, vals):
                 if v is None:
                     continue
                 if callable(v):
                     any_fn = True
-                    v = np.broadcast_to(np.asarray(v(t), dtype=float), ids.shape)
+                    v = self._load_value(v, t, ids, col)
                 ext[ids, col] += v
         if initial:
             self._load_fn = any_fn
         self._a["fext"].from_numpy(ext.astype(np.float64 if self._fdt == ti.f64 else np.float32))
+
+    def _load_value(self, fn, t, ids, col):
+        """A load given as a function of time, at ``t``: one number per id, or (3D
+        moments, ``col`` a slice) one 3-vector per id; refused naming the load."""
+        shape = ids.shape if not isinstance(col, slice) else (len(ids), 3)
+        raw = fn(t)
+        try:
+            v = np.broadcast_to(np.asarray(raw, dtype=float), shape)
+        except (TypeError, ValueError):
+            v = None
+        if v is None or not np.isfinite(v).all():
+            name = ("fx", "fy", "moment" if self.dim == 2 else "fz", "moment")[
+                3 if isinstance(col, slice) else col]
+            want = (f"three numbers or {len(ids)} rows of three" if isinstance(col, slice)
+                    else f"a finite number or {len(ids)} of them")
+            raise InputError(f"apply_force: {name} as a function of time returned {raw!r} "
+                             f"at t = {float(t):.6g} s; it must return {want}")
+        return v
 
     # ------------------------------------------------------------------ stepping
     def _step_args(self):

@@ -877,21 +877,30 @@ class Simulation(Runner, Results):
             self._apply_fixes(initial=True)
 
     def apply_force(self, ids, fx=None, fy=None, moment=None, fz=None):
-        """Apply forces (N per metre of thickness) and moments (N·m/m) to particles
-        ``ids``. Each of fx, fy, moment is None, a float, an array (one per id) or a
-        function of time returning either; loads add up over calls. Blocks have
-        :meth:`Block.apply_force` and :meth:`Block.apply_pressure`."""
+        """Apply forces and moments to particles ``ids``: in 2D forces in N per metre of
+        thickness and moments in N·m/m, in 3D N and N·m. Each of fx, fy (and fz in 3D)
+        is None, a float, an array (one per id) or a function of time returning either;
+        a 2D moment likewise, a 3D moment a 3-vector (for every id), an (n, 3) array or
+        a function of time returning either. Loads add up over calls and count in the
+        work account (``sim.work()["applied"]``). Blocks have :meth:`Block.apply_force`
+        and :meth:`Block.apply_pressure`."""
         ids = indices("ids", ids, self._n)
         if self.dim == 3:
-            raise InputError("apply_force: applied loads are 2D for now")
-        if fz is not None:
-            raise InputError(f"fz: a 2D simulation has no z axis (got fz={fz!r})")
-        vals = [_fix_value(name, v, ids)
-                for name, v in (("fx", fx), ("fy", fy), ("moment", moment))]
+            vals = [_fix_value(name, v, ids) for name, v in (("fx", fx), ("fy", fy), ("fz", fz))]
+            vals.append(_moment3(moment, ids))
+        else:
+            if fz is not None:
+                raise InputError(f"fz: a 2D simulation has no z axis (got fz={fz!r})")
+            vals = [_fix_value(name, v, ids)
+                    for name, v in (("fx", fx), ("fy", fy), ("moment", moment))]
         self._loads.append((ids, *vals))
-        self._loads_on = True
         if self._built:
-            self._apply_loads(initial=True)
+            try:
+                self._apply_loads(initial=True)   # (functions of time tried at once)
+            except Exception:
+                self._loads.pop()                 # (nothing was uploaded)
+                raise
+        self._loads_on = True
 
     # ------------------------------------------------------------- properties
     @property
@@ -1109,3 +1118,20 @@ class Simulation(Runner, Results):
         the iteration cap before their normal converged (0 in a healthy run; a run that
         has some warns at its end)."""
         return int(self._a["flags"].to_numpy()[F_NONCONV]) if self._built and self._n else 0
+
+
+def _moment3(v, ids):
+    """A 3D moment of apply_force: None, a function of time (checked when the run
+    evaluates it), or an (len(ids), 3) array from a 3-vector or one row per id."""
+    if v is None or callable(v):
+        return v
+    try:
+        a = np.asarray(v, dtype=float)
+        a = np.broadcast_to(a, (len(ids), 3)).copy() if a.shape in ((3,), (len(ids), 3)) else None
+    except (TypeError, ValueError):
+        a = None
+    if a is None or not np.isfinite(a).all():
+        raise InputError(f"moment must be None, three finite numbers (x, y, z), {len(ids)} "
+                         f"rows of three or a function of time, got {v!r}")
+    return a
+
