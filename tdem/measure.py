@@ -1,14 +1,16 @@
-"""Measurements over a region, as PFC's measurement circles and Yade's averages:
-the Love–Weber stress, porosity, coordination number and fabric tensor of the
-particles whose centres lie in a box, a circle or a polygon.
+"""Measurements over a region, as PFC's measurement circles and spheres and Yade's
+averages: the Love–Weber stress, porosity, coordination number and fabric tensor of
+the particles whose centres lie in a box, a circle or a polygon (2D), or a box or a
+sphere (3D).
 
-For the particles p in the region (area A):
+For the particles p in the region (area, in 3D volume, V):
 
-- stress σ = (1/A) Σ_p Σ_c sym((x_c − x_p) ⊗ f_c), f_c the force of contact c on p
+- stress σ = (1/V) Σ_p Σ_c sym((x_c − x_p) ⊗ f_c), f_c the force of contact c on p
   at its contact point x_c (particle and wall contacts), tension-positive (Love 1927,
   Weber 1966). Over a region that holds a whole specimen in equilibrium it is the
   stress its boundary carries; the pairs inside a region count once from each side;
-- porosity 1 − Σ_p π R_p² / A (a particle counts whole where its centre lies);
+- porosity 1 − Σ_p V_p / V (a particle counts whole where its centre lies; V_p its
+  area in 2D, its volume m_p/ρ_p in 3D);
 - coordination: the mean number of contacts (with particles and walls) of the
   particles in the region;
 - fabric φ = (1/N_c) Σ_c n_c ⊗ n_c over the contacts of those particles (trace 1).
@@ -25,30 +27,37 @@ from .pack import _polygon_area
 
 
 class Region:
-    """A box ((x0, y0), (x1, y1)), a circle ((cx, cy), r) or a polygon (K, 2)."""
+    """2D: a box ((x0, y0), (x1, y1)), a circle ((cx, cy), r) or a polygon (K, 2);
+    3D: a box ((x0, y0, z0), (x1, y1, z1)) or a sphere ((cx, cy, cz), r)."""
 
-    def __init__(self, box=None, circle=None, polygon=None):
-        given = [k for k, v in (("box", box), ("circle", circle), ("polygon", polygon))
-                 if v is not None]
+    def __init__(self, box=None, circle=None, polygon=None, sphere=None, dim=2):
+        given = [k for k, v in (("box", box), ("circle", circle), ("polygon", polygon),
+                                ("sphere", sphere)) if v is not None]
+        kinds = ("box", "circle", "polygon") if dim == 2 else ("box", "sphere")
         if len(given) != 1:
-            raise InputError(f"measure takes exactly one of box=, circle=, polygon=, got "
-                             f"{given or 'none'}")
+            raise InputError(f"measure takes exactly one of "
+                             f"{', '.join(k + '=' for k in kinds)} got {given or 'none'}")
         self.kind = given[0]
+        self.dim = dim
+        if self.kind not in kinds:
+            raise InputError(f"{self.kind}: a {('2D', '3D')[dim == 2]} region; a {dim}D "
+                             f"simulation measures over {' or '.join(kinds)}")
         try:
             if box is not None:
-                lo, hi = np.asarray(box, dtype=float).reshape(2, 2)
+                lo, hi = np.asarray(box, dtype=float).reshape(2, dim)
                 if not (np.all(np.isfinite([lo, hi])) and np.all(hi > lo)):
                     raise ValueError
                 self.lo, self.hi = lo, hi
                 self.area = float(np.prod(hi - lo))
-            elif circle is not None:
-                c, r = circle
-                self.c = np.asarray(c, dtype=float).reshape(2)
+            elif circle is not None or sphere is not None:
+                c, r = circle if circle is not None else sphere
+                self.c = np.asarray(c, dtype=float).reshape(dim)
                 self.r = float(r)
                 if not (np.all(np.isfinite(self.c)) and math.isfinite(self.r)
                         and self.r > 0):
                     raise ValueError
-                self.area = math.pi * self.r ** 2
+                self.area = (math.pi * self.r ** 2 if dim == 2
+                             else 4.0 / 3.0 * math.pi * self.r ** 3)
             else:
                 p = np.asarray(polygon, dtype=float)
                 if p.ndim != 2 or p.shape[1] != 2 or len(p) < 3 or not np.isfinite(p).all():
@@ -59,27 +68,33 @@ class Region:
                 from matplotlib.path import Path
                 self.path = Path(p)
         except (TypeError, ValueError):
-            value = {"box": box, "circle": circle, "polygon": polygon}[self.kind]
+            value = {"box": box, "circle": circle, "polygon": polygon,
+                     "sphere": sphere}[self.kind]
+            box_form = ("((x0, y0), (x1, y1)) with x1 > x0 and y1 > y0" if dim == 2 else
+                        "((x0, y0, z0), (x1, y1, z1)) with x1 > x0, y1 > y0 and z1 > z0")
             raise InputError(f"{self.kind} must be "
-                             + {"box": "((x0, y0), (x1, y1)) with x1 > x0 and y1 > y0",
+                             + {"box": box_form,
                                 "circle": "((cx, cy), r) with r > 0",
+                                "sphere": "((cx, cy, cz), r) with r > 0",
                                 "polygon": "(K, 2) vertices, K >= 3, of non-zero area"}
                              [self.kind] + f", got {value!r}") from None
 
     def contains(self, x):
-        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        x = np.asarray(x, dtype=float).reshape(-1, self.dim)
         if self.kind == "box":
             return np.all((x >= self.lo) & (x <= self.hi), axis=1)
-        if self.kind == "circle":
+        if self.kind in ("circle", "sphere"):
             return np.sum((x - self.c) ** 2, axis=1) <= self.r ** 2
         return self.path.contains_points(x)
 
 
-def measure(sim, box=None, circle=None, polygon=None):
+def measure(sim, box=None, circle=None, polygon=None, sphere=None):
     """The measurements of the module docstring for ``sim`` now: a dict with stress
-    (2, 2) Pa (N/m² per metre of thickness in 2D), porosity, coordination, fabric
-    (2, 2), particles (how many), contacts (how many counted), area (m²)."""
-    region = Region(box, circle, polygon)
+    (d, d) Pa (N/m² per metre of thickness in 2D), porosity, coordination, fabric
+    (d, d), particles (how many), contacts (how many counted), area (the region's
+    area, in 3D its volume; also as ``volume`` in 3D)."""
+    dim = sim.dim
+    region = Region(box, circle, polygon, sphere, dim)
     p = sim.particles.numpy() if sim.n_particles else None
     if p is None:
         raise InputError("measure needs particles: add some first")
@@ -87,8 +102,11 @@ def measure(sim, box=None, circle=None, polygon=None):
     c = sim.contacts.numpy()
     i, j = c["pairs"][:, 0], c["pairs"][:, 1]
     n = c["direction"]
-    t = np.stack([-n[:, 1], n[:, 0]], axis=1)
-    f = -c["normal"][:, None] * n + c["shear"][:, None] * t      # on the first particle
+    if dim == 2:
+        t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+        f = -c["normal"][:, None] * n + c["shear"][:, None] * t      # on the first particle
+    else:
+        f = -c["normal_force"][:, None] * n + c["shear_force"]
     # each contact seen from each of its particles in the region: (owner, force, normal)
     sides = []
     own = inside[i]
@@ -108,12 +126,18 @@ def measure(sim, box=None, circle=None, polygon=None):
     stress = 0.5 * (s + s.T) / region.area
     npart = int(inside.sum())
     ncont = len(owner)
-    fabric = (np.einsum("ca,cb->ab", normal, normal) / ncont) if ncont else np.zeros((2, 2))
-    area = math.pi * p["radius"] ** 2
-    if sim._n and sim._has_shapes:
-        rows = np.concatenate(sim._host["shape"])
-        area = np.where(rows[:, 2] > 0, rows[:, 3], area)     # a shape's own area
-    solid = float(np.sum(area[inside]))
-    return {"stress": stress, "porosity": 1.0 - solid / region.area,
-            "coordination": ncont / npart if npart else 0.0, "fabric": fabric,
-            "particles": npart, "contacts": ncont, "area": region.area}
+    fabric = (np.einsum("ca,cb->ab", normal, normal) / ncont) if ncont else np.zeros((dim, dim))
+    if dim == 2:
+        size = math.pi * p["radius"] ** 2
+        if sim._n and sim._has_shapes:
+            rows = np.concatenate(sim._host["shape"])
+            size = np.where(rows[:, 2] > 0, rows[:, 3], size)     # a shape's own area
+    else:
+        size = p["mass"] / np.concatenate(sim._host["density"])   # spheres, ellipsoids, polyhedra
+    solid = float(np.sum(size[inside]))
+    out = {"stress": stress, "porosity": 1.0 - solid / region.area,
+           "coordination": ncont / npart if npart else 0.0, "fabric": fabric,
+           "particles": npart, "contacts": ncont, "area": region.area}
+    if dim == 3:
+        out["volume"] = region.area
+    return out

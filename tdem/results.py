@@ -230,12 +230,13 @@ class Results:
                     "stress_zz": np.zeros(0)}
         return self._cont.elements()
 
-    def measure(self, box=None, circle=None, polygon=None):
+    def measure(self, box=None, circle=None, polygon=None, sphere=None):
         """Love–Weber stress (tension-positive), porosity, coordination and fabric of the
         particles whose centres lie in a box ``((x0, y0), (x1, y1))``, a circle
-        ``((cx, cy), r)`` or a polygon ``(K, 2)`` (:mod:`tdem.measure`)."""
+        ``((cx, cy), r)`` or a polygon ``(K, 2)``; in 3D a box ``((x0, y0, z0), (x1, y1,
+        z1))`` or a sphere ``((cx, cy, cz), r)`` (:mod:`tdem.measure`)."""
         from .measure import measure
-        return measure(self, box=box, circle=circle, polygon=polygon)
+        return measure(self, box=box, circle=circle, polygon=polygon, sphere=sphere)
 
     def point_edge_contacts(self):
         """Point–edge contacts in force now (particle–block and block–block), a dict of

@@ -3,7 +3,8 @@
 A pack compressed between four walls and brought to rest: over the region the walls
 enclose, the Love–Weber stress is the stress the walls carry (σ_xx = −F_x/H, σ_yy =
 −F_y/W, tension-positive) within 2 %; porosity, coordination and fabric follow from
-their definitions."""
+their definitions. In 3D, periodic cubic lattices of pressed spheres and ellipsoids,
+against the Hertz force and the lattice's geometry."""
 import math
 
 import numpy as np
@@ -90,3 +91,90 @@ def test_porosity_coordination_and_fabric(pack):
 def test_bad_regions_are_refused(pack, kw, match):
     with pytest.raises(tdem.InputError, match=match):
         pack[0].measure(**kw)
+
+
+def _periodic_lattice(shape=None, n=4, R=0.01, delta=2e-4, semi=None):
+    """A simple cubic lattice, periodic on all three axes, of spheres of radius R (or
+    ellipsoids of semi-axes ``semi``, not turned), each pressed into its six
+    neighbours by ``delta`` (``n`` cells, or one number per axis); no gravity, at rest: every particle in equilibrium."""
+    hm = tdem.HertzMindlin(young=1e8, poisson=0.25, friction=0.5, restitution=0.5)
+    half = np.array(semi if semi is not None else (R, R, R))
+    step = 2.0 * half - delta
+    n = np.broadcast_to(n, 3)                # cells along x, y, z
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), progress=False)
+    sim.periodic(x=(0.0, n[0] * step[0]), y=(0.0, n[1] * step[1]), z=(0.0, n[2] * step[2]))
+    g = (np.stack(np.meshgrid(*[np.arange(k) for k in n], indexing="ij"), -1).reshape(-1, 3)
+         + 0.5) * step
+    if semi is None:
+        sim.add_particles(g, R, density=2000.0, contact=hm)
+    else:
+        sim.add_particles(g, shape=tdem.Ellipsoid(*semi), density=2000.0, contact=hm)
+    sim.run(steps=1)
+    return sim, step, hm
+
+
+def test_3d_love_weber_stress_of_a_pressed_cubic_lattice():
+    """Each sphere pressed by δ into its six neighbours carries the Hertz force
+    F = 4/3 E* √(R/2) δ^{3/2} on each; over any region of whole cells the stress is
+    −F/a² on the diagonal (a = 2R − δ the lattice step) and zero off it, porosity
+    1 − (4/3)πR³/a³, coordination 6, fabric I/3. In a box of 2³ cells and in a sphere
+    about one particle holding it and its six neighbours."""
+    R, delta = 0.01, 2e-4
+    sim, step, hm = _periodic_lattice(R=R, delta=delta)
+    a = step[0]
+    e_star = hm.young / (2.0 * (1.0 - hm.poisson ** 2))
+    F = 4.0 / 3.0 * e_star * math.sqrt(0.5 * R) * delta ** 1.5
+    c = sim.contacts.numpy()
+    np.testing.assert_allclose(c["normal_force"], F, rtol=1e-9)
+    m = sim.measure(box=((a, a, a), (3.0 * a, 3.0 * a, 3.0 * a)))
+    assert m["particles"] == 8 and m["volume"] == pytest.approx(8.0 * a ** 3)
+    np.testing.assert_allclose(m["stress"], -F / a ** 2 * np.eye(3), atol=1e-9 * F / a ** 2)
+    assert m["porosity"] == pytest.approx(1.0 - 4.0 / 3.0 * math.pi * R ** 3 / a ** 3,
+                                          rel=1e-12)
+    assert m["coordination"] == pytest.approx(6.0)
+    np.testing.assert_allclose(m["fabric"], np.eye(3) / 3.0, atol=1e-12)
+    centre = 2.5 * a                       # a particle's centre
+    r = 1.1 * a
+    s = sim.measure(sphere=((centre, centre, centre), r))
+    assert s["particles"] == 7
+    vol = 4.0 / 3.0 * math.pi * r ** 3
+    np.testing.assert_allclose(s["stress"], -7.0 * F * a / vol * np.eye(3),
+                               atol=1e-9 * F * a / vol)
+
+
+def test_3d_measure_of_a_pressed_lattice_of_ellipsoids():
+    """Ellipsoids (not turned) on a lattice of steps 2a − δ, 2b − δ, 2c − δ: the force
+    along each axis F_k acts at the midpoint of the support points, half a step from
+    each centre, so σ_kk = −F_k s_k / (s_x s_y s_z); the porosity counts each
+    ellipsoid's volume (4/3)πabc."""
+    semi = (0.012, 0.009, 0.006)
+    sim, step, _ = _periodic_lattice(semi=semi, delta=1.5e-4, n=(4, 5, 8))
+    c = sim.contacts.numpy()
+    axis = np.argmax(np.abs(c["direction"]), axis=1)
+    np.testing.assert_allclose(np.abs(c["direction"][np.arange(len(axis)), axis]), 1.0,
+                               atol=1e-9)
+    forces = np.array([c["normal_force"][axis == k].mean() for k in range(3)])
+    for k in range(3):
+        np.testing.assert_allclose(c["normal_force"][axis == k], forces[k], rtol=1e-6)
+    cell = float(np.prod(step))
+    lo, hi = step, 3.0 * step
+    m = sim.measure(box=(lo, hi))
+    assert m["particles"] == 8
+    np.testing.assert_allclose(np.diag(m["stress"]), -forces * step / cell, rtol=1e-6)
+    assert np.abs(m["stress"] - np.diag(np.diag(m["stress"]))).max() < 1e-6 * forces.max() / step.max() ** 2
+    assert m["porosity"] == pytest.approx(1.0 - 4.0 / 3.0 * math.pi * np.prod(semi) / cell,
+                                          rel=1e-9)
+
+
+def test_3d_regions_are_checked():
+    sim, step, _ = _periodic_lattice()
+    with pytest.raises(tdem.InputError, match="circle: a 2D region"):
+        sim.measure(circle=((0.0, 0.0), 1.0))
+    with pytest.raises(tdem.InputError, match=r"box must be \(\(x0, y0, z0\)"):
+        sim.measure(box=((0.0, 0.0), (1.0, 1.0)))
+    with pytest.raises(tdem.InputError, match="sphere must be"):
+        sim.measure(sphere=((0.0, 0.0, 0.0), -1.0))
+    flat = tdem.Simulation(progress=False)
+    flat.add_particles([[0.0, 0.0]], 0.1, contact=tdem.LinearContact(kn=1e5))
+    with pytest.raises(tdem.InputError, match="sphere: a 3D region"):
+        flat.measure(sphere=((0.0, 0.0, 0.0), 1.0))
