@@ -767,6 +767,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         q1 = angle[i]
         ell = False
         lmid = w0 * 0.0
+        lfree = w0 * 0.0
         if ti.static(shapes and dim == 3):
             # an ellipsoid: the angular momentum at the half steps (world frame),
             # the orientation by the splitting of tdem.integrate.free_rotation
@@ -777,6 +778,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 l1, ml = damped_leapfrog(lmom[i], tq, 1.0, alpha, alpha_l, dt)
                 md = ml
                 lmid = 0.5 * (lmom[i] + l1)
+                lfree = l1
                 q1, w1 = free_rotation(q1, l1, inertia3, shaped3d.el.rotation(q1), dt)
                 lmom[i] = l1
         vfree = v1
@@ -803,7 +805,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         # the leapfrog's m(v_{n+1/2} − v_{n−1/2}) = ΣF Δt their sum is the change of
         # ½ m v² at the half steps, exactly (round-off apart). The damping force is
         # F_d − α m (v_{n−1/2} + v_free)/2 (tdem.integrate), the constraint's impulse
-        # m (v_{n+1/2} − v_free). Contact dissipation and the walls' work were booked in 1.
+        # m (v_{n+1/2} − v_free); for the rotation of an ellipsoid or a polyhedron the
+        # same in its angular momentum, M_d − α (L_{n−1/2} + L_free)/2 and L_{n+1/2} −
+        # L_free. Contact dissipation and the walls' work were booked in 1.
         vm = 0.5 * (v0 + v1)
         wm = 0.5 * (w0 + w1)
         x0 = pos[i]
@@ -816,9 +820,15 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         if ti.static(loads):
             ework[i][5] += (fa.dot(vm) + spin_dot(ma, wm, dim)) * dt
         if damped or fx != 0:
+            m_damp = md - alpha * inertia * 0.5 * (w0 + wfree)
+            j_fix = inertia * (w1 - wfree)
+            if ti.static(shapes and dim == 3):
+                if ell:
+                    m_damp = md - alpha * lmid
+                    j_fix = lmom[i] - lfree
             w_damp = ((fd - alpha * m * 0.5 * (v0 + vfree)).dot(vm)
-                      + spin_dot(md - alpha * inertia * 0.5 * (w0 + wfree), wm, dim)) * dt
-            w_fix = m * (v1 - vfree).dot(vm) + inertia * spin_dot(w1 - wfree, wm, dim)
+                      + spin_dot(m_damp, wm, dim)) * dt
+            w_fix = m * (v1 - vfree).dot(vm) + spin_dot(j_fix, wm, dim)
             ework[i][3] += w_damp
             ework[i][4] += w_fix
             eacc[i] += ti.Vector([-w_damp, w_fix])

@@ -216,22 +216,28 @@ def test_checkpoint_written_before_the_work_account_loads(tmp_path):
     assert w["contacts"] != 0.0 and abs(w["residual"]) < 1e-9 * _scale(w)
 
 
-@pytest.mark.parametrize("shape", ["spheres", "cubes", "ellipsoids"])
-def test_3d_kinetic_energy_change_equals_recorded_work(shape):
-    """3D beds in contact, falling onto a mesh floor (tests/small_models.py): the work
-    of contacts and gravity adds up to the kinetic energy change, rotation included
-    (½ ω·L for shaped bodies). For spheres and cubes, whose spin is along their
-    angular momentum, exactly (round-off); for the tumbling ellipsoids to the
-    rotation splitting's error, which falls with the time step."""
+@pytest.mark.parametrize("shape, damping", [("spheres", 0.0), ("cubes", 0.0),
+                                            ("ellipsoids", 0.0), ("cubes", 5.0),
+                                            ("ellipsoids", 5.0)])
+def test_3d_kinetic_energy_change_equals_recorded_work(shape, damping):
+    """3D beds in contact, falling onto a mesh floor (tests/small_models.py), with and
+    without global damping: the work of contacts, gravity and damping adds up to the
+    kinetic energy change, rotation included (½ ω·L for shaped bodies; the damping
+    moment of an ellipsoid acts on its angular momentum). For spheres and cubes,
+    whose spin is along their angular momentum, exactly (round-off); for the
+    tumbling ellipsoids to the rotation splitting's error, which falls with the time
+    step."""
     import small_models
 
     def residual(divide):
         sim = getattr(small_models, shape)()
+        sim.global_damping = damping
         dt = sim.dt
         sim.dt = dt / divide
         sim.run(until=300 * dt)
         w = sim.work()
         assert abs(w["contacts"]) > 1e-3 and w["gravity"] != 0.0
+        assert (w["damping"] < -0.1 * abs(w["contacts"])) == (damping > 0.0)
         return w["residual"] / abs(w["contacts"])
 
     r1 = residual(1)
@@ -240,3 +246,17 @@ def test_3d_kinetic_energy_change_equals_recorded_work(shape):
     else:
         assert abs(r1) < 1e-4
         assert abs(residual(4)) < 0.5 * abs(r1)
+
+
+def test_work_of_a_spin_held_on_an_ellipsoid():
+    """An ellipsoid held at a constant spin about no principal axis: its angular
+    momentum turns with it, and the constraint's work (the impulse on L, times ω) is
+    the change of its kinetic energy ½ ω·L, to round-off."""
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), dt=1e-4, progress=False)
+    sim.add_particles([[0.0, 0.0, 0.0]], shape=tdem.Ellipsoid(0.03, 0.02, 0.01),
+                      density=2000.0, contact=tdem.HertzMindlin(young=1e7, poisson=0.3))
+    sim.fix_particles([0], vx=None, omega=(3.0, 1.0, 2.0))
+    sim.run(steps=3000)
+    w = sim.work()
+    assert w["constraints"] > 1e-5
+    assert abs(w["residual"]) < 1e-12 * w["constraints"]
