@@ -188,9 +188,11 @@ class Block:
         return _in_box(self.vertices, xmin, xmax, ymin, ymax)
 
 
-def _in_box(x, xmin, xmax, ymin, ymax):
-    return np.flatnonzero((x[:, 0] >= xmin) & (x[:, 0] <= xmax) &
-                          (x[:, 1] >= ymin) & (x[:, 1] <= ymax))
+def _in_box(x, xmin, xmax, ymin, ymax, zmin=-np.inf, zmax=np.inf):
+    inside = (x[:, 0] >= xmin) & (x[:, 0] <= xmax) & (x[:, 1] >= ymin) & (x[:, 1] <= ymax)
+    if x.shape[1] > 2:
+        inside &= (x[:, 2] >= zmin) & (x[:, 2] <= zmax)
+    return np.flatnonzero(inside)
 
 
 def _fix_value(name, v, ids):

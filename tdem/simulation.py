@@ -725,12 +725,29 @@ class Simulation(Runner, Results):
             rows.append((ids, a, b, law, kn, ks))
         return rows
 
-    def particles_in(self, xmin=-np.inf, xmax=np.inf, ymin=-np.inf, ymax=np.inf):
-        """Indices of the particles whose centres lie in the box (now)."""
+    def particles_in(self, xmin=-np.inf, xmax=np.inf, ymin=-np.inf, ymax=np.inf,
+                     zmin=None, zmax=None):
+        """Indices of the particles whose centres lie in the box (now); zmin and zmax
+        in 3D."""
+        bounds = dict(xmin=xmin, xmax=xmax, ymin=ymin, ymax=ymax, zmin=zmin, zmax=zmax)
+        if self.dim == 2:
+            for name in ("zmin", "zmax"):
+                if bounds[name] is not None:
+                    raise InputError(f"{name}: a 2D simulation has no z axis "
+                                     f"(got {name}={bounds[name]!r})")
+        bounds["zmin"] = -np.inf if zmin is None else zmin
+        bounds["zmax"] = np.inf if zmax is None else zmax
+        for name, v in bounds.items():
+            try:
+                bad = math.isnan(float(v))
+            except (TypeError, ValueError):
+                bad = True
+            if bad:
+                raise InputError(f"{name} must be a number, got {v!r}")
         if self._n == 0:
             return np.zeros(0, np.int64)
         pos = self._a["pos"].to_numpy() if self._built else np.concatenate(self._host["pos"])
-        return _in_box(pos, xmin, xmax, ymin, ymax)
+        return _in_box(pos, **bounds)
 
     def set_contact(self, group_a, group_b, contact):
         """Use ``contact`` between particles of two groups (default: the law of the group

@@ -399,3 +399,28 @@ def test_sphere_crossing_a_periodic_side_keeps_its_mesh_floor(axis):
     assert vals[-1, 0] == pytest.approx(0.05 * 0.03 - 0.05 * R, abs=1e-4)
     np.testing.assert_allclose(vals[:, 2], weight, rtol=0.05)
     np.testing.assert_allclose(vals[:, 1], R - delta, atol=0.1 * delta)
+
+
+def test_particles_in_a_3d_box_and_the_bottom_layer_held():
+    """sim.particles_in with z bounds picks a layer of a 4 × 4 × 3 lattice (16 of 48);
+    held by fix_particles, that layer stays put while the others fall freely for 0.05 s
+    (z drops by g t²/2 to 1 %); z bounds in 2D and a NaN bound are refused."""
+    sim = tdem.Simulation(dim=3, progress=False)
+    g = np.stack(np.meshgrid(*[np.arange(4) * 0.05] * 2, np.arange(3) * 0.05,
+                             indexing="ij"), -1).reshape(-1, 3)
+    sim.add_particles(g, 0.01, density=RHO, contact=tdem.HertzMindlin(young=E, poisson=NU))
+    bottom = sim.particles_in(zmax=0.01)
+    assert len(bottom) == 16 and np.all(g[bottom, 2] == 0.0)
+    assert len(sim.particles_in(zmin=0.04, zmax=0.06, xmax=0.06)) == 8
+    sim.fix_particles(bottom, vx=0.0, vy=0.0, vz=0.0)
+    sim.run(until=0.05)                   # (they fall 12 mm, a gap of 30 mm below)
+    z = sim.particles.numpy()["position"][:, 2]
+    np.testing.assert_array_equal(z[bottom], 0.0)
+    rest = np.setdiff1d(np.arange(len(g)), bottom)
+    np.testing.assert_allclose(g[rest, 2] - z[rest], 0.5 * 9.81 * sim.time ** 2, rtol=0.01)
+    with pytest.raises(tdem.InputError, match="zmin must be a number"):
+        sim.particles_in(zmin=float("nan"))
+    flat = tdem.Simulation(progress=False)
+    flat.add_particles([[0.0, 0.0]], 0.1, contact=tdem.LinearContact(kn=1e5))
+    with pytest.raises(tdem.InputError, match="zmax: a 2D simulation has no z axis"):
+        flat.particles_in(zmax=1.0)
