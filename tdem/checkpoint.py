@@ -81,6 +81,8 @@ def _config(sim):
         "dim": int(sim.dim),
         "broad_phase": sim.broad_phase,
         "meshes": [[int(a), int(b)] for a, b in sim._meshes],
+        "mesh_servo": [[int(m), float(k), float(f), [float(x) for x in d], float(a), float(v)]
+                       for m, (k, f, d, a, v) in sorted(sim._mesh_servo.items())],
         "polyhedra": [p.input_vertices.tolist() for p in getattr(sim, "_polys", [])],
         "account0": sim._account0,
         "couples": [{"ids": None if ids is None else [int(i) for i in ids],
@@ -569,6 +571,8 @@ def load(path, arch=None):
     sim._periodic = [None if p is None else tuple(p)
                      for p in cfg.get("periodic", [None] * sim.dim)]
     sim._meshes = [tuple(m) for m in cfg.get("meshes", [])]
+    sim._mesh_servo = {m: (k, f, np.asarray(d, float), a, v)
+                       for m, k, f, d, a, v in cfg.get("mesh_servo", [])}
     sim._polys = [Polyhedron(v) for v in cfg.get("polyhedra", [])]
     sim._fixes = fixes
     sim._n = cfg["n"]

@@ -372,6 +372,68 @@ class Mesh:
         first, count = self._sim._meshes[self.index]
         return self._sim._wall_loads()[first:first + count]
 
+    def servo(self, force=None, stress=None, direction=None, relaxation=0.5, max_speed=None):
+        """Drive this mesh so that it receives ``force`` (N, compression-positive) — or
+        ``stress`` (Pa) × its area — along ``direction``, the unit direction in which it
+        moves to compress (default: its area-weighted mean normal, turned towards the
+        particles' centroid; a mesh without one, a closed box, needs it given). As a
+        segment's :meth:`Wall.servo`: the speed for the next step is set on the device
+        from the force received, relaxation × (target − measured)/(contacts × k), k a
+        contact's stiffness; ``max_speed`` caps it (default: 0.01 × the smallest radius
+        per step). The mesh translates; ``mesh.servo()`` switches the control off and
+        stops it."""
+        sim = self._sim
+        first, count = sim._meshes[self.index]
+        if force is None and stress is None:
+            sim._mesh_servo.pop(self.index, None)
+            self._set(stepk.T_VX, np.zeros(3))
+            sim._upload_mesh_servo()
+            return self
+        if (force is None) == (stress is None):
+            raise InputError(f"give force or stress, not both: force={force!r}, stress={stress!r}")
+        tri = self.triangles
+        cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        area = 0.5 * float(np.linalg.norm(cross, axis=1).sum())
+        try:
+            target = float(force) if force is not None else float(stress) * area
+        except (TypeError, ValueError):
+            target = float("nan")
+        if not math.isfinite(target):
+            name = "force" if force is not None else "stress"
+            raise InputError(f"{name} must be a finite number, got "
+                             f"{force if force is not None else stress!r}")
+        if direction is None:
+            mean = 0.5 * cross.sum(axis=0)
+            if np.linalg.norm(mean) <= 1e-6 * area:
+                raise InputError(f"direction: mesh {self.index} has no mean normal (a closed "
+                                 "surface?); give the direction in which it moves to compress")
+            d = mean / np.linalg.norm(mean)
+            x = sim.particles.numpy(stress=False)["position"] if sim.n_particles else None
+            if x is not None and len(x):
+                tri_mid = tri.reshape(-1, 3).mean(axis=0)
+                if np.dot(x.mean(axis=0) - tri_mid, d) < 0:
+                    d = -d
+        else:
+            d = _vector2("direction", direction, 3)
+            if np.linalg.norm(d) == 0:
+                raise InputError(f"direction must not be zero, got {direction!r}")
+            d = d / np.linalg.norm(d)
+        relaxation = float(relaxation)
+        if not 0.0 < relaxation <= 1.0:
+            raise InputError(f"relaxation must lie in (0, 1], got {relaxation!r}")
+        law = sim._laws[int(self._rows()[0, stepk.T_LAW])]
+        r = sim._radii()
+        k = law.critical_stiffness(float(r.mean()) if len(r) else 1.0, 1.0)
+        if max_speed is None:
+            max_speed = 0.01 * float(r.min() if len(r) else 1.0) / sim.dt
+        max_speed = float(max_speed)
+        if not (max_speed > 0 and math.isfinite(max_speed)):
+            raise InputError(f"max_speed must be a positive number, got {max_speed!r}")
+        self._set(stepk.T_WX, np.zeros(3))
+        sim._mesh_servo[self.index] = (k, target, d, relaxation, max_speed)
+        sim._upload_mesh_servo()
+        return self
+
     @property
     def force(self):
         """Total contact force (3,) the mesh received in the last step."""

@@ -310,6 +310,7 @@ class Runner:
         self._a["lawpair"].from_numpy(self._law_table())
 
     def _upload_params(self):
+        self._upload_mesh_servo()
         p = np.zeros(stepk.SIMP_SIZE)
         p[stepk.P_DT] = self.dt
         p[[stepk.P_GX, stepk.P_GY, stepk.P_GZ][:self.dim]] = self.gravity
@@ -324,6 +325,27 @@ class Runner:
                 p[c0], p[cl] = span[0], span[1] - span[0]
         self._a["simp"].from_numpy(p)
         self._dt_run = p[stepk.P_DT]
+
+    def _upload_mesh_servo(self):
+        """The servo-controlled meshes' rows (:func:`tdem.step.servo_meshes`), from
+        ``_mesh_servo`` (mesh index -> k, target, direction, relaxation, speed limit);
+        None when no mesh has a servo."""
+        servo = getattr(self, "_mesh_servo", {})
+        if not servo or not self._built:
+            self._mservo_arr = None
+            return
+        rows = np.zeros((len(servo), stepk.MS_WIDTH))
+        for r, (m, (k, target, d, relax, vmax)) in enumerate(sorted(servo.items())):
+            first, count = self._meshes[m]
+            rows[r, [stepk.MS_FIRST, stepk.MS_COUNT, stepk.MS_K, stepk.MS_F]] = \
+                first, count, k, target
+            rows[r, stepk.MS_DX:stepk.MS_DZ + 1] = d
+            rows[r, [stepk.MS_ALPHA, stepk.MS_VMAX]] = relax, vmax
+        arr = getattr(self, "_mservo_arr", None)
+        if arr is None or tuple(arr.shape) != rows.shape:
+            arr = ti.ndarray(ti.f64, shape=rows.shape)
+        arr.from_numpy(rows)
+        self._mservo_arr = arr
 
     def _wall_rows(self):
         if not self._built:
@@ -655,6 +677,8 @@ class Runner:
         if self._n:
             stepk.step(*step_args, int(detail), cont is not None and cont.adds_forces, self._law_set,
                        self._shape_code, self.dim)
+            if self._mservo_arr is not None:
+                stepk.servo_meshes(self._a["wall"], self._a["wforce"], self._mservo_arr, dt)
         if cont is not None:
             cont.integrate(self)
             cont.eos_volumes(self, dt)

@@ -976,6 +976,41 @@ def move_triangle(wall: ti.template(), w, dt, skin, flags: ti.template()):
                 flags[F_REBUILD] = 1
 
 
+# a mesh's servo control (tdem.handles.Mesh.servo): a row per servo-controlled mesh
+(MS_FIRST, MS_COUNT, MS_K, MS_F, MS_DX, MS_DY, MS_DZ, MS_ALPHA, MS_VMAX) = range(9)
+MS_WIDTH = 9
+
+
+@cached
+@ti.kernel
+def servo_meshes(wall: ti.types.ndarray(), wforce: ti.types.ndarray(),
+                 mservo: ti.types.ndarray(), dt: ti.f64):
+    """3D: the velocity of each servo-controlled mesh for the next step, from the force
+    its triangles received in this one, as :func:`servo_velocity` does for a segment:
+    relaxation × (target − measured)/(contacts × k) per step along its direction d,
+    the measured force the compression it receives along −d, |v| <= the speed limit.
+    (One thread: a few meshes; launched after the step only in models with a servo.)"""
+    ti.loop_config(serialize=True)
+    for m in range(mservo.shape[0]):
+        first = ti.cast(mservo[m, MS_FIRST], ti.i32)
+        count = ti.cast(mservo[m, MS_COUNT], ti.i32)
+        d = ti.Vector([mservo[m, MS_DX], mservo[m, MS_DY], mservo[m, MS_DZ]])
+        f = ti.Vector([0.0, 0.0, 0.0])
+        contacts = 0.0
+        for w in range(first, first + count):
+            fw = wforce[w]
+            f += ti.Vector([fw[0], fw[1], fw[2]])
+            contacts += fw[6]
+        measured = -f.dot(d)
+        k = mservo[m, MS_K] * ti.max(contacts, 1.0)
+        v = mservo[m, MS_ALPHA] * (mservo[m, MS_F] - measured) / (k * dt)
+        vmax = mservo[m, MS_VMAX]
+        v = ti.math.clamp(v, -vmax, vmax)
+        for w in range(first, first + count):
+            for c in ti.static(range(3)):
+                wall[w, T_VX + c] = v * d[c]
+
+
 @ti.kernel
 def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                     omega: ti.types.ndarray(), prop: ti.types.ndarray(),

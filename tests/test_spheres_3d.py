@@ -424,3 +424,73 @@ def test_particles_in_a_3d_box_and_the_bottom_layer_held():
     flat.add_particles([[0.0, 0.0]], 0.1, contact=tdem.LinearContact(kn=1e5))
     with pytest.raises(tdem.InputError, match="zmax: a 2D simulation has no z axis"):
         flat.particles_in(zmax=1.0)
+
+
+def _servo_bed(tmp_path=None):
+    """Spheres in a box periodic in x and y, on a floor, under a lid held at a target
+    force by its servo; damped to rest."""
+    L, R = 0.06, 0.005
+    hm = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.3, restitution=0.5)
+    smooth = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.0, restitution=0.5)
+    sim = tdem.Simulation(dim=3, local_damping=0.5, progress=False)
+    sim.periodic(x=(0.0, L), y=(0.0, L))
+    floor = sim.add_mesh(*tdem.surfaces.plane((0.5 * L, 0.5 * L, 0.0), (0.0, 0.0, 1.0),
+                                              L + 0.03, 2), contact=smooth)
+    lid = sim.add_mesh(*tdem.surfaces.plane((0.5 * L, 0.5 * L, 0.045), (0.0, 0.0, -1.0),
+                                            L + 0.03, 2), contact=smooth)
+    g = (np.stack(np.meshgrid(*[np.arange(6)] * 2, np.arange(3), indexing="ij"), -1)
+         .reshape(-1, 3) + 0.5) * 0.0102
+    sim.add_particles(g, R, density=2500.0, contact=hm)
+    return sim, floor, lid
+
+
+def test_a_servo_lid_holds_its_target_force_on_a_bed():
+    """A lid under servo control (target 30 N, far above the bed's weight of 0.14 N)
+    comes down, meets the bed and presses it until it receives the target within
+    1 %; the floor then carries the target plus the weight within 1 %. Switched
+    off, the lid stops."""
+    sim, floor, lid = _servo_bed()
+    target = 30.0
+    lid.servo(force=target)
+    weight = float(sim.particles.numpy()["mass"].sum()) * 9.81
+    sim.run(until=0.4)
+    assert lid.force[2] > 0.0                  # (it touches the bed)
+    sim.run(until=0.6)
+    assert lid.force[2] == pytest.approx(target, rel=0.01)     # pushed up by the bed
+    assert -floor.force[2] == pytest.approx(target + weight, rel=0.01)
+    assert lid.velocity[2] == pytest.approx(0.0, abs=1e-3)
+    lid.servo()
+    np.testing.assert_array_equal(lid.velocity, 0.0)
+
+
+def test_a_servo_mesh_restarts_bit_for_bit(tmp_path):
+    sim, floor, lid = _servo_bed()
+    lid.servo(stress=5e3)                       # × the lid's area (0.09 × 0.09 m²)
+    sim.run(steps=100)
+    assert lid.velocity[2] < 0.0                # (coming down when saved)
+    sim.save(tmp_path / "s.h5")
+    sim.run(steps=600)
+    back = tdem.Simulation.load(tmp_path / "s.h5")
+    back.run(steps=600)
+    np.testing.assert_array_equal(sim.particles.numpy()["position"],
+                                  back.particles.numpy()["position"])
+    np.testing.assert_array_equal(sim.meshes[1].triangles, back.meshes[1].triangles)
+    np.testing.assert_array_equal(sim.meshes[1].force, back.meshes[1].force)
+    assert sim.meshes[1].force[2] == pytest.approx(5e3 * 0.09 ** 2, rel=0.01)
+
+
+def test_mesh_servo_input_is_checked():
+    sim, floor, lid = _servo_bed()
+    with pytest.raises(tdem.InputError, match="not both"):
+        lid.servo(force=1.0, stress=1.0)
+    with pytest.raises(tdem.InputError, match="relaxation"):
+        lid.servo(force=1.0, relaxation=1.5)
+    with pytest.raises(tdem.InputError, match="direction must not be zero"):
+        lid.servo(force=1.0, direction=(0.0, 0.0, 0.0))
+    with pytest.raises(tdem.InputError, match="force must be a finite number"):
+        lid.servo(force=float("nan"))
+    box = sim.add_mesh(*tdem.surfaces.box((0.0, 0.0, 0.0), (0.01, 0.01, 0.01),
+                                                open_top=False),
+                       contact=tdem.HertzMindlin(young=1e7, poisson=0.3))
+    with pytest.raises(tdem.InputError, match="direction: mesh 2 has no mean normal"):
+        box.servo(force=1.0)
