@@ -10,6 +10,8 @@ Every function returns ``(positions, radii)``: float arrays of shapes (N, 2) and
   rectangle or a polygon, by radius expansion with overlap relaxation.
 - :func:`fill_holes`: discs added into the holes a packing's PCMM element cover
   leaves.
+- 3D: :func:`lattice3d` (fcc or cubic centres), :func:`random3d` (a random packing of
+  spheres in a box, by the same radius expansion with overlap relaxation).
 
 The lattices put the outermost centres ``inset`` from the edges of the rectangle:
 ``inset = R`` (the default) keeps every disc inside it; ``inset = 0`` puts centres
@@ -658,3 +660,91 @@ def lattice3d(lower, upper, radius, kind="fcc"):
     ijk = np.stack(np.meshgrid(*[np.arange(k) for k in n], indexing="ij"), -1).reshape(-1, 3)
     pts = ((ijk[:, None, :] + basis[None]) * cell).reshape(-1, 3) + lo
     return pts[np.all(pts <= hi + 1e-12 * cell, axis=1)]
+
+
+def random3d(lower, upper, rmin, rmax, seed=0, target_fraction=0.5, overlap_tol=1e-3,
+             max_iter=20000):
+    """Random packing of spheres with radii uniform in [rmin, rmax] in the box
+    [lower, upper] (3D), as :func:`random` packs discs: radii drawn until the spheres'
+    volume reaches ``target_fraction`` × the box's, centres uniform in the box, the
+    radii grown from half size while overlaps (pairs, and spheres against the box's
+    faces) are relaxed by heavy-ball sweeps, until no overlap exceeds ``overlap_tol``
+    × rmin. Returns (positions (N, 3), radii (N,)), listed from the bottom up (by z);
+    deterministic for a ``seed``.
+
+    ``target_fraction`` must lie in (0, 0.62]: random packings of spheres jam near
+    0.64, less against walls. About 1,000 spheres (radii 4–6 mm in a 0.1 m cube)
+    pack in under a second up to 0.55 and in 2 s at 0.57; 0.58 is not reached in
+    the default sweeps (a fraction it cannot reach raises :class:`tdem.InputError`
+    after ``max_iter`` sweeps, naming the largest overlap left). Such a packing is
+    at rest, its spheres barely touching: settle it under gravity or compress it
+    for a bed (as PFC's ``ball distribute`` and Yade's ``makeCloud`` are used)."""
+    from scipy.spatial import cKDTree
+    rmin, rmax = _radius_range(rmin, rmax)
+    overlap_tol = _positive("overlap_tol", overlap_tol)
+    tf = float(target_fraction)
+    if not (0.0 < tf <= 0.62):
+        raise InputError(f"target_fraction must lie in (0, 0.62], got {target_fraction!r}")
+    try:
+        lo = np.asarray(lower, dtype=float).reshape(3)
+        hi = np.asarray(upper, dtype=float).reshape(3)
+    except (TypeError, ValueError):
+        raise InputError(f"lower and upper must be 3 numbers each, got lower={lower!r}, "
+                         f"upper={upper!r}") from None
+    if not (np.all(np.isfinite([lo, hi])) and np.all(hi - lo >= 2 * rmax)):
+        raise InputError(f"upper must exceed lower by at least 2 rmax on every axis, got "
+                         f"lower={lower!r}, upper={upper!r}, rmax={rmax!r}")
+    volume = float(np.prod(hi - lo))
+    rng = np.random.default_rng(seed)
+    sphere = 4.0 / 3.0 * math.pi
+    mean_vol = sphere * (rmax ** 4 - rmin ** 4) / (4.0 * (rmax - rmin)) if rmax > rmin \
+        else sphere * rmin ** 3
+    est = int(tf * volume / mean_vol * 1.1) + 16
+    r = rng.uniform(rmin, rmax, est)
+    while np.sum(sphere * r ** 3) < tf * volume:
+        r = np.concatenate([r, rng.uniform(rmin, rmax, est)])
+    n = int(np.searchsorted(np.cumsum(sphere * r ** 3), tf * volume)) + 1
+    r = r[:n]
+    x = rng.uniform(lo + rmin, hi - rmin, (n, 3))
+    tol = overlap_tol * rmin
+    skin = 0.5 * rmin
+    scale = 0.5
+    vel = np.zeros((n, 3))
+    x_ref = None
+    worst = np.inf
+    for _ in range(int(max_iter)):
+        if x_ref is None or np.max(np.sum((x - x_ref) ** 2, axis=1)) > (0.5 * skin) ** 2:
+            pairs = cKDTree(x).query_pairs(2 * rmax + skin, output_type="ndarray")
+            i, j = pairs[:, 0], pairs[:, 1]
+            x_ref = x.copy()
+        rs = scale * r
+        d = x[j] - x[i]
+        dist = np.sqrt(np.einsum("nk,nk->n", d, d))
+        ov = rs[i] + rs[j] - dist
+        hit = ov > 0
+        push = np.zeros((n, 3))
+        worst = 0.0
+        if hit.any():
+            worst = float(ov[hit].max())
+            s = (0.5 * ov[hit] / np.maximum(dist[hit], 1e-300))[:, None] * d[hit]
+            for k in range(3):
+                push[:, k] += np.bincount(j[hit], s[:, k], minlength=n) - np.bincount(
+                    i[hit], s[:, k], minlength=n)
+        # the box's faces: back inside by the penetration
+        below = rs[:, None] - (x - lo)
+        above = rs[:, None] - (hi - x)
+        worst = max(worst, float(below.max()), float(above.max()))
+        push += np.maximum(below, 0.0) - np.maximum(above, 0.0)
+        if scale == 1.0 and worst <= tol:
+            order = np.lexsort((x[:, 0], x[:, 1], x[:, 2]))
+            return x[order], r[order]
+        if np.sum(push * vel) < 0.0:
+            vel[:] = 0.0
+        vel = _MOMENTUM * vel + push
+        x = x + vel
+        scale = min(1.0, scale + _GROWTH)
+    raise InputError(f"target_fraction={target_fraction!r} could not be reached with "
+                     f"overlaps of at most overlap_tol={overlap_tol!r} x rmin in {max_iter} "
+                     f"sweeps (largest overlap {worst:.3g} m); lower it or raise "
+                     f"overlap_tol")
+
