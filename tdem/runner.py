@@ -650,7 +650,9 @@ class Runner:
         5. point–edge contacts (coupling) — ``xforce``, ``nforce``;
         6. viscous (non-reflecting) boundaries — ``xforce``, ``nforce``;
         7. DEM pairs and walls, gathered with ``xforce``, and the particles' damped
-           leapfrog (tdem.step, one kernel) — particle state, contacts, walls;
+           leapfrog (tdem.step, one kernel) — particle state, contacts, walls; then,
+           in 3D models with servo-controlled meshes, their speeds for the next step
+           (tdem.step.servo_meshes);
         8. block nodes and rigid blocks integrated (tdem.integrate) — node state;
         9. the volume change of the step of particles with an equation of state, by
            the elements that pushed over it (physics.pcmm.volumes) — ``pjwl``.
