@@ -49,6 +49,11 @@ ANNOUNCE_SECONDS = 30.0
 ANNOUNCE_MEASURE = 0.5
 
 
+# how far above the stable step at the present largest Hertz overlap a run's step may
+# be before it warns (Runner._warn_stiffened)
+STIFFENED_MARGIN = 1.1
+
+
 class Runner:
     """Device state and the run loop of :class:`tdem.Simulation` (module docstring)."""
 
@@ -677,8 +682,8 @@ class Runner:
             cont.point_edge(self, dt)
             cont.viscous_boundaries(self)
         if self._n:
-            stepk.step(*step_args, int(detail), cont is not None and cont.adds_forces, self._law_set,
-                       self._shape_code, self.dim)
+            stepk.step(*step_args, int(detail), cont is not None and cont.adds_forces,
+                       self._law_set, self._shape_code, self.dim)
             if self._mservo_arr is not None:
                 stepk.servo_meshes(self._a["wall"], self._a["wforce"], self._mservo_arr, dt)
         if cont is not None:
@@ -826,7 +831,45 @@ class Runner:
             self._output.flush(self)
         if self._has_shapes:
             self._warn_nonconverged()
+        self._warn_stiffened()
         return self
+
+    def _warn_stiffened(self):
+        """Say when the step has become unstable for the contacts as they are now.
+        Hertz contacts stiffen as they overlap (k_n ∝ sqrt(δ)), and the step
+        (:meth:`tdem.Simulation.stable_dt`) is that of contacts overlapping by 5 % of
+        the radius: a bed pressed harder needs a smaller one, by (0.05 R/δ)^(1/4) at
+        its largest overlap δ. Without this the bed jitters at speed under damping,
+        its walls disagree and its integration makes energy, none of it reported.
+        Checked after each run of a sphere model whose laws are all Hertz–Mindlin (of
+        seven particles or more), with a margin (``STIFFENED_MARGIN``: the dense
+        packing's bound is that of six contacts a particle, most have fewer); once
+        per simulation."""
+        if (self._cont is not None or self._n < 7 or self._has_shapes
+                or getattr(self, "_stiff_warned", False)
+                or not all(type(law).__name__ == "HertzMindlin" for law in self._laws)):
+            return
+        c = self.contacts.numpy()
+        if not len(c["pairs"]):
+            return
+        r = self._a["prop"].to_numpy()[:, 0]
+        i, j = c["pairs"][:, 0], c["pairs"][:, 1]
+        rj = np.where(j >= 0, r[np.maximum(j, 0)], r[i])
+        ratio = float(np.max(c["overlap"] / np.minimum(r[i], rj)))
+        if ratio <= 0.05:
+            return
+        stable = self.stable_dt() * (0.05 / ratio) ** 0.25
+        if self._dt_run > STIFFENED_MARGIN * stable:
+            self._stiff_warned = True
+            warnings.warn(
+                f"dt = {self._dt_run:.4g} s is more than 10 % above {stable:.4g} s, the "
+                f"stable step of a dense packing whose Hertz contacts overlap by "
+                f"{100.0 * ratio:.3g} % of the "
+                f"radius, as the largest do now (stable_dt() = {self.stable_dt():.4g} s is "
+                f"for 5 %): the particles jitter and the integration makes energy "
+                f"(sim.energy()['integration_error']); use dt <= {stable:.4g} s or a "
+                f"dt_fraction below {self.dt_fraction * stable / self._dt_run:.3g}",
+                RuntimeWarning, stacklevel=3)
 
     def _warn_nonconverged(self):
         """Say when shaped-particle contacts stopped at the iteration cap (their normal

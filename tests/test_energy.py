@@ -7,6 +7,7 @@
     (Σ wall forces = Σ m g, the resultant of the external forces on the discs is 0).
 """
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -129,3 +130,49 @@ def test_walls_carry_the_weight_of_a_settled_pile():
     assert floor.force[1] < 0 and right.force[0] > 0 and left.force[0] < 0
     side = (right.force[1] + left.force[1]) / -weight
     assert 0.0 < side < 0.5
+
+
+def _pressed_bed(dt_factor):
+    """A random bed of 446 soft Hertz spheres in a box periodic in x and y, pressed by
+    a lid to about 40 kPa and held: its contacts overlap by up to a fifth of a radius,
+    four times the overlap the default step is chosen for, and twice as stiff."""
+    L, H = 0.06, 0.05
+    x, r = tdem.pack.random3d((0, 0, 0), (L, L, H), 0.003, 0.004, seed=2,
+                              target_fraction=0.45)
+    hm = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.3, restitution=0.3)
+    smooth = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.0, restitution=0.3)
+    sim = tdem.Simulation(dim=3, gravity=(0, 0, 0), local_damping=0.7, progress=False)
+    sim.periodic(x=(0.0, L), y=(0.0, L))
+    floor = sim.add_mesh(*tdem.surfaces.plane((L / 2, L / 2, 0.0), (0, 0, 1.0), L + 0.03, 2),
+                         contact=smooth)
+    lid = sim.add_mesh(*tdem.surfaces.plane((L / 2, L / 2, H), (0, 0, -1.0), L + 0.03, 2),
+                       contact=smooth, velocity=(0, 0, -0.1))
+    sim.add_particles(x, r, density=2500.0, contact=hm)
+    sim.dt = sim.dt * dt_factor
+    return sim, floor, lid
+
+
+def _press_and_hold(sim, lid):
+    sim.run(until=0.17)
+    lid.velocity = (0, 0, 0)
+    sim.run(until=0.3)
+
+
+def test_a_step_unstable_for_a_pressed_bed_is_not_silent():
+    """At the default step the pressed bed never comes to rest: its spheres jitter at
+    metres per second under local damping 0.7 and the integration makes energy (over a
+    hundred times the bed's elastic energy). The run says so (its step is 1.28 times
+    the stable step at the largest overlap). At half the step the same bed comes to rest (lid and floor equal to
+    1e-9) and nothing is said."""
+    sim, floor, lid = _pressed_bed(1.0)
+    with pytest.warns(RuntimeWarning, match="dense packing whose Hertz contacts overlap"):
+        _press_and_hold(sim, lid)
+    e = sim.energy()
+    assert e["integration_error"] > 100 * e["elastic"]
+    assert np.abs(sim.particles.numpy()["velocity"]).max() > 0.5
+    calm, floor, lid = _pressed_bed(0.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _press_and_hold(calm, lid)
+    assert lid.force[2] == pytest.approx(-floor.force[2], rel=1e-9)
+    assert np.abs(calm.particles.numpy()["velocity"]).max() < 1e-9
