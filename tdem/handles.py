@@ -195,6 +195,49 @@ def _in_box(x, xmin, xmax, ymin, ymax, zmin=-np.inf, zmax=np.inf):
     return np.flatnonzero(inside)
 
 
+def _servo_target(force, stress, size):
+    """The force a servo holds (Wall.servo, Mesh.servo): ``force``, or ``stress`` × the
+    wall's length or the mesh's area; checked."""
+    if (force is None) == (stress is None):
+        raise InputError(f"give force or stress, not both: force={force!r}, stress={stress!r}")
+    name, value = ("force", force) if force is not None else ("stress", stress)
+    try:
+        target = float(value) * (1.0 if force is not None else size)
+    except (TypeError, ValueError):
+        target = float("nan")
+    if not math.isfinite(target):
+        raise InputError(f"{name} must be a finite number, got {value!r}")
+    return target
+
+
+def _servo_settings(sim, law, direction, normal, centre, relaxation, max_speed):
+    """A servo's unit direction (``direction``, else ``normal`` turned towards the
+    particles' centroid as seen from ``centre``), a contact's stiffness k of its law
+    at the mean radius, its relaxation and speed limit (default 0.01 × the smallest
+    radius per step); checked, naming the argument."""
+    if direction is None:
+        d = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
+        x = sim.particles.numpy(stress=False)["position"] if sim.n_particles else None
+        if x is not None and len(x) and np.dot(x.mean(axis=0) - centre, d) < 0:
+            d = -d
+    else:
+        d = _vector2("direction", direction, len(normal))
+        if np.linalg.norm(d) == 0:
+            raise InputError(f"direction must not be zero, got {direction!r}")
+        d = d / np.linalg.norm(d)
+    relaxation = float(relaxation)
+    if not 0.0 < relaxation <= 1.0:
+        raise InputError(f"relaxation must lie in (0, 1], got {relaxation!r}")
+    r = sim._radii()
+    k = law.critical_stiffness(float(r.mean()) if len(r) else 1.0, 1.0)
+    if max_speed is None:
+        max_speed = 0.01 * float(r.min() if len(r) else 1.0) / sim.dt
+    max_speed = float(max_speed)
+    if not (max_speed > 0 and math.isfinite(max_speed)):
+        raise InputError(f"max_speed must be a positive number, got {max_speed!r}")
+    return d, k, relaxation, max_speed
+
+
 def _fix_value(name, v, ids):
     if v is None or callable(v):
         return v
@@ -269,39 +312,13 @@ class Wall:
         if force is None and stress is None:
             self._set([stepk.W_SERVO_K, stepk.W_VX, stepk.W_VY], [0.0, 0.0, 0.0])
             return self
-        if (force is None) == (stress is None):
-            raise InputError(f"give force or stress, not both: force={force!r}, stress={stress!r}")
         a, b = self.endpoints
         length = float(np.linalg.norm(b - a))
-        target = float(force) if force is not None else float(stress) * length
-        if not math.isfinite(target):
-            raise InputError(f"force must be finite, got {target!r}")
-        if direction is None:
-            t = (b - a) / length
-            d = np.array([-t[1], t[0]])
-            x = sim.particles.numpy(stress=False)["position"] if sim.n_particles else None
-            if x is not None and len(x):
-                mid = 0.5 * (a + b)
-                if np.dot(x.mean(axis=0) - mid, d) < 0:
-                    d = -d
-        else:
-            d = _vector2("direction", direction)
-            if np.linalg.norm(d) == 0:
-                raise InputError(f"direction must not be zero, got {direction!r}")
-            d = d / np.linalg.norm(d)
-        relaxation = float(relaxation)
-        if not 0.0 < relaxation <= 1.0:
-            raise InputError(f"relaxation must lie in (0, 1], got {relaxation!r}")
-        law = sim._laws[int(row[stepk.W_LAW])]
-        r = sim._radii()
-        rmean = float(r.mean()) if len(r) else 1.0
-        k = law.critical_stiffness(rmean, 1.0)
-        dt = sim.dt
-        if max_speed is None:
-            max_speed = 0.01 * float(r.min() if len(r) else 1.0) / dt
-        max_speed = float(max_speed)
-        if not (max_speed > 0 and math.isfinite(max_speed)):
-            raise InputError(f"max_speed must be a positive number, got {max_speed!r}")
+        target = _servo_target(force, stress, length)
+        t = (b - a) / length
+        d, k, relaxation, max_speed = _servo_settings(
+            sim, sim._laws[int(row[stepk.W_LAW])], direction, np.array([-t[1], t[0]]),
+            0.5 * (a + b), relaxation, max_speed)
         self._set([stepk.W_SERVO_K, stepk.W_SERVO_F, stepk.W_SERVO_DX, stepk.W_SERVO_DY,
                    stepk.W_SERVO_ALPHA, stepk.W_SERVO_VMAX, stepk.W_OMEGA],
                   [k, target, d[0], d[1], relaxation, max_speed, 0.0])
@@ -389,46 +406,17 @@ class Mesh:
             self._set(stepk.T_VX, np.zeros(3))
             sim._upload_mesh_servo()
             return self
-        if (force is None) == (stress is None):
-            raise InputError(f"give force or stress, not both: force={force!r}, stress={stress!r}")
         tri = self.triangles
         cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         area = 0.5 * float(np.linalg.norm(cross, axis=1).sum())
-        try:
-            target = float(force) if force is not None else float(stress) * area
-        except (TypeError, ValueError):
-            target = float("nan")
-        if not math.isfinite(target):
-            name = "force" if force is not None else "stress"
-            raise InputError(f"{name} must be a finite number, got "
-                             f"{force if force is not None else stress!r}")
-        if direction is None:
-            mean = 0.5 * cross.sum(axis=0)
-            if np.linalg.norm(mean) <= 1e-6 * area:
-                raise InputError(f"direction: mesh {self.index} has no mean normal (a closed "
-                                 "surface?); give the direction in which it moves to compress")
-            d = mean / np.linalg.norm(mean)
-            x = sim.particles.numpy(stress=False)["position"] if sim.n_particles else None
-            if x is not None and len(x):
-                tri_mid = tri.reshape(-1, 3).mean(axis=0)
-                if np.dot(x.mean(axis=0) - tri_mid, d) < 0:
-                    d = -d
-        else:
-            d = _vector2("direction", direction, 3)
-            if np.linalg.norm(d) == 0:
-                raise InputError(f"direction must not be zero, got {direction!r}")
-            d = d / np.linalg.norm(d)
-        relaxation = float(relaxation)
-        if not 0.0 < relaxation <= 1.0:
-            raise InputError(f"relaxation must lie in (0, 1], got {relaxation!r}")
-        law = sim._laws[int(self._rows()[0, stepk.T_LAW])]
-        r = sim._radii()
-        k = law.critical_stiffness(float(r.mean()) if len(r) else 1.0, 1.0)
-        if max_speed is None:
-            max_speed = 0.01 * float(r.min() if len(r) else 1.0) / sim.dt
-        max_speed = float(max_speed)
-        if not (max_speed > 0 and math.isfinite(max_speed)):
-            raise InputError(f"max_speed must be a positive number, got {max_speed!r}")
+        target = _servo_target(force, stress, area)
+        mean = 0.5 * cross.sum(axis=0)
+        if direction is None and np.linalg.norm(mean) <= 1e-6 * area:
+            raise InputError(f"direction: mesh {self.index} has no mean normal (a closed "
+                             "surface?); give the direction in which it moves to compress")
+        d, k, relaxation, max_speed = _servo_settings(
+            sim, sim._laws[int(self._rows()[0, stepk.T_LAW])], direction, mean,
+            tri.reshape(-1, 3).mean(axis=0), relaxation, max_speed)
         self._set(stepk.T_WX, np.zeros(3))
         sim._mesh_servo[self.index] = (k, target, d, relaxation, max_speed)
         sim._upload_mesh_servo()
