@@ -849,13 +849,9 @@ class Runner:
                 or getattr(self, "_stiff_warned", False)
                 or not all(type(law).__name__ == "HertzMindlin" for law in self._laws)):
             return
-        c = self.contacts.numpy()
-        if not len(c["pairs"]):
-            return
-        r = self._a["prop"].to_numpy()[:, 0]
-        i, j = c["pairs"][:, 0], c["pairs"][:, 1]
-        rj = np.where(j >= 0, r[np.maximum(j, 0)], r[i])
-        ratio = float(np.max(c["overlap"] / np.minimum(r[i], rj)))
+        a = self._a
+        ratio = float(stepk.largest_overlap_ratio(a["cs"], a["nbr"], a["ncnt"], a["wcs"],
+                                                  a["wid"], a["prop"]))
         if ratio <= 0.05:
             return
         stable = self.stable_dt() * (0.05 / ratio) ** 0.25

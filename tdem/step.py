@@ -1012,6 +1012,28 @@ def servo_meshes(wall: ti.types.ndarray(), wforce: ti.types.ndarray(),
 
 
 @ti.kernel
+def largest_overlap_ratio(cs: ti.types.ndarray(), nbr: ti.types.ndarray(),
+                          ncnt: ti.types.ndarray(), wcs: ti.types.ndarray(),
+                          wid: ti.types.ndarray(), prop: ti.types.ndarray()) -> ti.f64:
+    """The largest overlap over the smaller radius among the contacts of the last
+    recording step (the overlaps ``cs`` and ``wcs`` hold; a wall counts with the
+    particle's radius): read after a run by Runner._warn_stiffened. One thread, a
+    fixed order."""
+    out = 0.0
+    ti.loop_config(serialize=True)
+    for i in range(nbr.shape[0]):
+        ri = prop[i][PROP_RADIUS]
+        for k in range(ncnt[i]):
+            u = cs[i, k][2]
+            if u > 0.0:
+                out = ti.max(out, u / ti.min(ri, prop[nbr[i, k]][PROP_RADIUS]))
+        for k in range(wid.shape[1]):
+            if wid[i, k] >= 0 and wcs[i, k][2] > 0.0:
+                out = ti.max(out, wcs[i, k][2] / ri)
+    return out
+
+
+@ti.kernel
 def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                     omega: ti.types.ndarray(), prop: ti.types.ndarray(),
                     flags: ti.types.ndarray(), dt: ti.f64, dim: ti.template()):

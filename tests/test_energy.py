@@ -161,7 +161,7 @@ def _press_and_hold(sim, lid):
 def test_a_step_unstable_for_a_pressed_bed_is_not_silent():
     """At the default step the pressed bed never comes to rest: its spheres jitter at
     metres per second under local damping 0.7 and the integration makes energy (over a
-    hundred times the bed's elastic energy). The run says so (its step is 1.28 times
+    hundred times the bed's elastic energy). The run says so (its step is 1.3–1.4 times
     the stable step at the largest overlap). At half the step the same bed comes to rest (lid and floor equal to
     1e-9) and nothing is said."""
     sim, floor, lid = _pressed_bed(1.0)
