@@ -358,21 +358,7 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
         rs = scale * r
         if nb:
             rs[:nb] = r[:nb]
-        d = x[j] - x[i]
-        dist = np.sqrt(np.einsum("nk,nk->n", d, d))
-        ov = rs[i] + rs[j] - dist
-        hit = ov > 0
-        push = np.zeros((n, 2))
-        worst = 0.0
-        if hit.any():
-            worst = float(ov[hit].max())
-            # half the overlap to each disc; all of it to a free disc against a fixed one
-            share = np.where(free[i[hit]] & free[j[hit]], 0.5, 1.0)
-            s = (share * ov[hit] / np.maximum(dist[hit], 1e-300))[:, None] * d[hit]
-            for k in range(2):
-                push[:, k] += np.bincount(j[hit], s[:, k], minlength=n) - np.bincount(
-                    i[hit], s[:, k], minlength=n)
-            push[~free] = 0.0
+        push, worst = _pair_push(x, rs, i, j, free)
         if len(near_edge):
             sd, inward = _signed_distance(x[near_edge], poly)
             pen = rs[near_edge] - sd
@@ -385,16 +371,48 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
                 x, r = _fill(x, r, poly, pcmm_tolerance, rmin, rmax, overlap_tol,
                              not edge_centres)
             return _in_rows(x, r, nb)
-        # heavy-ball relaxation, restarted when the motion turns against the push
-        if np.sum(push * vel) < 0.0:
-            vel[:] = 0.0
-        vel = _MOMENTUM * vel + push
-        x = x + vel
+        x, vel = _heavy_ball(x, vel, push)
         scale = min(1.0, scale + _GROWTH)
-    raise InputError(f"target_fraction={target_fraction!r} could not be reached with "
-                     f"overlaps of at most overlap_tol={overlap_tol!r} x rmin in {max_iter} "
-                     f"sweeps (largest overlap {worst:.3g} m); lower it or raise "
-                     f"overlap_tol")
+    raise _unreached(target_fraction, overlap_tol, max_iter, worst)
+
+
+def _pair_push(x, rs, i, j, free=None):
+    """The relaxation's pushes of a sweep: each overlapping pair (i, j) of radii ``rs``
+    pushed apart by half its overlap each, all of it to a free particle against a
+    fixed one (``free`` False: not moved); returns (push (N, dim), largest overlap)."""
+    n, dim = x.shape
+    d = x[j] - x[i]
+    dist = np.sqrt(np.einsum("nk,nk->n", d, d))
+    ov = rs[i] + rs[j] - dist
+    hit = ov > 0
+    push = np.zeros((n, dim))
+    worst = 0.0
+    if hit.any():
+        worst = float(ov[hit].max())
+        share = 0.5 if free is None else np.where(free[i[hit]] & free[j[hit]], 0.5, 1.0)
+        s = (share * ov[hit] / np.maximum(dist[hit], 1e-300))[:, None] * d[hit]
+        for k in range(dim):
+            push[:, k] += np.bincount(j[hit], s[:, k], minlength=n) - np.bincount(
+                i[hit], s[:, k], minlength=n)
+        if free is not None:
+            push[~free] = 0.0
+    return push, worst
+
+
+def _heavy_ball(x, vel, push):
+    """One sweep of the heavy-ball relaxation, restarted when the motion turns against
+    the push: the new (x, vel)."""
+    if np.sum(push * vel) < 0.0:
+        vel[:] = 0.0
+    vel = _MOMENTUM * vel + push
+    return x + vel, vel
+
+
+def _unreached(target_fraction, overlap_tol, max_iter, worst):
+    return InputError(f"target_fraction={target_fraction!r} could not be reached with "
+                      f"overlaps of at most overlap_tol={overlap_tol!r} x rmin in {max_iter} "
+                      f"sweeps (largest overlap {worst:.3g} m); lower it or raise "
+                      f"overlap_tol")
 
 
 def _radius_range(rmin, rmax):
@@ -718,18 +736,7 @@ def random3d(lower, upper, rmin, rmax, seed=0, target_fraction=0.5, overlap_tol=
             i, j = pairs[:, 0], pairs[:, 1]
             x_ref = x.copy()
         rs = scale * r
-        d = x[j] - x[i]
-        dist = np.sqrt(np.einsum("nk,nk->n", d, d))
-        ov = rs[i] + rs[j] - dist
-        hit = ov > 0
-        push = np.zeros((n, 3))
-        worst = 0.0
-        if hit.any():
-            worst = float(ov[hit].max())
-            s = (0.5 * ov[hit] / np.maximum(dist[hit], 1e-300))[:, None] * d[hit]
-            for k in range(3):
-                push[:, k] += np.bincount(j[hit], s[:, k], minlength=n) - np.bincount(
-                    i[hit], s[:, k], minlength=n)
+        push, worst = _pair_push(x, rs, i, j)
         # the box's faces: back inside by the penetration
         below = rs[:, None] - (x - lo)
         above = rs[:, None] - (hi - x)
@@ -738,13 +745,7 @@ def random3d(lower, upper, rmin, rmax, seed=0, target_fraction=0.5, overlap_tol=
         if scale == 1.0 and worst <= tol:
             order = np.lexsort((x[:, 0], x[:, 1], x[:, 2]))
             return x[order], r[order]
-        if np.sum(push * vel) < 0.0:
-            vel[:] = 0.0
-        vel = _MOMENTUM * vel + push
-        x = x + vel
+        x, vel = _heavy_ball(x, vel, push)
         scale = min(1.0, scale + _GROWTH)
-    raise InputError(f"target_fraction={target_fraction!r} could not be reached with "
-                     f"overlaps of at most overlap_tol={overlap_tol!r} x rmin in {max_iter} "
-                     f"sweeps (largest overlap {worst:.3g} m); lower it or raise "
-                     f"overlap_tol")
+    raise _unreached(target_fraction, overlap_tol, max_iter, worst)
 
