@@ -34,24 +34,68 @@ from .materials import MAT_G, MAT_K, mc_correct_state
 from .pcmm import viscous_stress
 
 
+@ti.func
+def _mid_kinematics(t, npos: ti.template(), nvel: ti.template(), dt):
+    """Velocity gradient (Eq. 6) and area of triangle t on the mid-step configuration
+    x_n − ½Δt·v_{n−1/2} (module docstring)."""
+    va, vb, vc = nvel[t[0]], nvel[t[1]], nvel[t[2]]
+    h = 0.5 * dt
+    ya, yb, yc = npos[t[0]] - h * va, npos[t[1]] - h * vb, npos[t[2]] - h * vc
+    return fvm.velocity_gradient(ya, yb, yc, va, vb, vc), fvm.area(ya, yb, yc)
+
+
+@ti.func
+def _nodal_mean(v, k, tfor: ti.template(), inc_start: ti.template(), inc: ti.template()):
+    """Σ S_e q_e / Σ S_e over the triangles at node v, with (q_e, S_e) in columns
+    k, 4 of ``tfor`` (0 where no stressed triangle meets the node)."""
+    num = 0.0
+    den = 0.0
+    for q in range(inc_start[v], inc_start[v + 1]):
+        r = tfor[inc[q] // 3]
+        num += r[4] * r[k]
+        den += r[4]
+    out = 0.0
+    if den > 0.0:
+        out = num / den
+    return out
+
+
 @cached
 @ti.kernel
 def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.ndarray(),
            tmat: ti.types.ndarray(), matp: ti.types.ndarray(), tsig: ti.types.ndarray(),
            tstate: ti.types.ndarray(), tfor: ti.types.ndarray(),
            inc_start: ti.types.ndarray(), inc: ti.types.ndarray(),
-           nforce: ti.types.ndarray(), dt: ti.f64, serial: ti.template()):
+           nmix: ti.types.ndarray(), nforce: ti.types.ndarray(), dt: ti.f64,
+           mixed: ti.template(), serial: ti.template()):
     """One step of every block triangle (stress and nodal forces), then the element
-    forces gathered into ``nforce`` (overwritten)."""
+    forces gathered into ``nforce`` (overwritten). ``mixed``: the nodal mixed
+    discretization (:mod:`physics.fvm`), the volumetric strain increment and the
+    in-plane mean stress of the nodal forces averaged through the nodes (not
+    ``mixed``: each triangle's own). ``tfor`` holds each triangle's kinematics
+    between the passes; ``nmix`` (V, 2) the nodal means."""
+    # 1. kinematics: (Δθ, area) per triangle (area 0 for a rigid block's)
     ti.loop_config(serialize=serial)
     for e in range(tri.shape[0]):
+        out = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
         if tmat[e] >= 0:            # −1: a triangle of a rigid block (no stress)
-            t = tri[e]
-            xa, xb, xc = npos[t[0]], npos[t[1]], npos[t[2]]
-            va, vb, vc = nvel[t[0]], nvel[t[1]], nvel[t[2]]
-            h = 0.5 * dt
-            grad = fvm.velocity_gradient(xa - h * va, xb - h * vb, xc - h * vc, va, vb, vc)
+            grad, s = _mid_kinematics(tri[e], npos, nvel, dt)
             de = fvm.strain_increment(grad, dt)
+            out = ti.Vector([de[0] + de[1], 0.0, 0.0, 0.0, s, 0.0])
+        tfor[e] = out
+    # 2. the nodes' area-weighted volumetric strain increments
+    ti.loop_config(serialize=serial)
+    for v in range(nmix.shape[0]):
+        nmix[v] = ti.Vector([_nodal_mean(v, 0, tfor, inc_start, inc), 0.0])
+    # 3. stresses with the strain increment's volumetric part the mean of the nodes'
+    ti.loop_config(serialize=serial)
+    for e in range(tri.shape[0]):
+        if tmat[e] >= 0:
+            t = tri[e]
+            grad, s = _mid_kinematics(t, npos, nvel, dt)
+            de = fvm.strain_increment(grad, dt)
+            if ti.static(mixed):
+                de = fvm.mixed_strain(de, (nmix[t[0]][0] + nmix[t[1]][0] + nmix[t[2]][0]) / 3.0)
             M = tmat[e]
             sig = fvm.jaumann_rotate(tsig[e], fvm.spin_rate(grad), dt) + fvm.elastic_increment(
                 de, matp[M, MAT_K], matp[M, MAT_G])
@@ -62,8 +106,24 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
             if flag > 0:
                 st[1] = 1.0
             tstate[e] = st
-            fa, fb, fc = fvm.nodal_forces(sig + viscous_stress(matp, M, de, dt), xa, xb, xc, 1.0)
+            sf = sig + viscous_stress(matp, M, de, dt)
+            tfor[e] = ti.Vector([sf[0], sf[1], sf[2], sf[3], s, 0.5 * (sf[0] + sf[1])])
+    # 4. the nodes' area-weighted in-plane mean stresses
+    ti.loop_config(serialize=serial)
+    for v in range(nmix.shape[0]):
+        nmix[v][1] = _nodal_mean(v, 5, tfor, inc_start, inc)
+    # 5. nodal forces of each triangle, its in-plane mean stress the mean of the nodes'
+    ti.loop_config(serialize=serial)
+    for e in range(tri.shape[0]):
+        if tmat[e] >= 0:
+            t = tri[e]
+            r = tfor[e]
+            sf = ti.Vector([r[0], r[1], r[2], r[3]])
+            if ti.static(mixed):
+                sf = fvm.mixed_stress(sf, (nmix[t[0]][1] + nmix[t[1]][1] + nmix[t[2]][1]) / 3.0)
+            fa, fb, fc = fvm.nodal_forces(sf, npos[t[0]], npos[t[1]], npos[t[2]], 1.0)
             tfor[e] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
+    # 6. gathered per node in a fixed order
     ti.loop_config(serialize=serial)
     for v in range(nforce.shape[0]):
         f = ti.Vector([0.0, 0.0])

@@ -43,6 +43,32 @@ Equations
   mesh under a uniform σ the interior nodes get zero and a boundary node gets
   −½·σ·n·ΔL from each boundary edge it ends: minus the traction σ·n.
 
+Nodal mixed discretization
+--------------------------
+Constant-strain triangles lock when they flow plastically at constant volume: each
+element must keep its own area, about one volumetric constraint per degree of
+freedom of a triangle mesh (two for the PCMM element system, which superposes both
+diagonals of a square lattice), and a soil that must collapse stands. As FLAC does
+for its zones (Marti & Cundall 1982) and FLAC3D for tetrahedra (nodal mixed
+discretization), the volumetric part is taken through the nodes, with one
+constraint per node:
+
+- each node (particle) a averages the elements' volumetric strain increments,
+  Δθ_a = Σ_e V_e Δθ_e / Σ_e V_e over the elements containing it, V_e the element's
+  area (PCMM: its share k·S_e/N_e, k its multiplicity);
+- an element's strain increment keeps its own deviatoric part and takes the mean
+  of its three nodes' Δθ_a as its volumetric part (:func:`mixed_strain`), before
+  the stress update and the material's correction;
+- the in-plane mean stress of its nodal forces is likewise the mean over its nodes
+  of their averages of the elements' mean stresses (:func:`mixed_stress`); the
+  deviatoric part and σzz stay the element's.
+
+Both averages are the same operator A, which is self-adjoint for the weights V_e,
+so the forces do the work the stresses store: Σ V_e m_e (AΔθ)_e = Σ V_e (Am)_e
+Δθ_e. A uniform strain rate is left as it is (a patch test passes), and so is every
+element's deviatoric behaviour. ``Simulation(mixed_discretization=False)`` runs the
+elements' own update (docs/pcmm.md compares the two).
+
 Kernels
 -------
 The kernels take ``ti.types.ndarray`` arguments (compiled once per process, per
@@ -155,6 +181,24 @@ def constitutive(sig):
     tension cut-off) will act on the stress before the nodal forces are computed.
     """
     return sig
+
+
+@ti.func
+def mixed_strain(de, theta):
+    """The strain increment de = (Δεxx, Δεyy, Δεxy) with its volumetric part Δθ
+    replaced by ``theta`` (the nodal mixed discretization: the mean over the
+    element's nodes of their averaged Δθ); the deviatoric part is the element's."""
+    h = 0.5 * (theta - de[0] - de[1])
+    return ti.Vector([de[0] + h, de[1] + h, de[2]], dt=ti.f64)
+
+
+@ti.func
+def mixed_stress(sig, mean):
+    """The stress 4-vector with its in-plane mean (σxx + σyy)/2 replaced by ``mean``
+    (the mean over the element's nodes of their averaged in-plane mean stress):
+    the stress of the nodal forces under the nodal mixed discretization."""
+    h = mean - 0.5 * (sig[0] + sig[1])
+    return ti.Vector([sig[0] + h, sig[1] + h, sig[2], sig[3]], dt=ti.f64)
 
 
 @ti.func

@@ -80,6 +80,7 @@ def _config(sim):
         "periodic": [None if p is None else [float(p[0]), float(p[1])] for p in sim._periodic],
         "dim": int(sim.dim),
         "broad_phase": sim.broad_phase,
+        "mixed_discretization": bool(sim.mixed_discretization),
         "meshes": [[int(a), int(b)] for a, b in sim._meshes],
         "mesh_servo": [[int(m), float(k), float(f), [float(x) for x in d], float(a), float(v)]
                        for m, (k, f, d, a, v) in sorted(sim._mesh_servo.items())],
@@ -539,7 +540,9 @@ def load(path, arch=None):
                      local_damping=cfg["local_damping"], global_damping=cfg["global_damping"],
                      skin=cfg["skin"], check_interval=cfg["check_interval"],
                      progress=cfg["progress"], dim=cfg.get("dim", 2),
-                     broad_phase=cfg.get("broad_phase", "grid"))
+                     broad_phase=cfg.get("broad_phase", "grid"),
+                     # files written before the mixed discretization continue without it
+                     mixed_discretization=bool(cfg.get("mixed_discretization", False)))
     sim._dt_user = cfg["dt"]
     sim._laws = [ContactLaw.from_dict(d) for d in cfg["laws"]]
     sim._pair_override = {(a, b): c for a, b, c in cfg["pair_override"]}

@@ -109,7 +109,8 @@ class Continuum:
     blocks : list of :class:`tdem.simulation.Block`
     """
 
-    def __init__(self, pos, rad, pmat, slots, blocks, capacity=16, couples=(), walls=None):
+    def __init__(self, pos, rad, pmat, slots, blocks, capacity=16, couples=(), walls=None,
+                 mixed=True):
         self.n = len(rad)
         self.slots = slots
         self.blocks = blocks
@@ -167,6 +168,7 @@ class Continuum:
         a["sigp"] = _arr(4, (n * E,))
         a["ede"] = _arr(7, (n, E))
         a["psig"] = _arr(4, (n,))
+        a["pmix"] = _arr(2, (n,))       # the particles' means of the mixed discretization
         a["peps"] = _arr(3, (n,))
         a["pstate"] = _arr(4, (n,))
         # JWL particles: relative volume V, energy E per initial volume, lighting time,
@@ -203,6 +205,7 @@ class Continuum:
         self._setup_couples(couples)
         self.nr = {}
         self.carry_stress = True
+        self.mixed = bool(mixed)     # the nodal mixed discretization (physics.fvm)
         self.snap = {}
 
     # ------------------------------------------------------------------ set-up
@@ -379,6 +382,7 @@ class Continuum:
         # its kinetic energy at the start
         a["nwork"] = _arr(6, (nv,))
         a["nload"] = _arr(2, (nv,))      # applied loads (Block.apply_force, apply_pressure)
+        a["nmix"] = _arr(2, (nv,))       # nodal means of the mixed discretization
         a["tri"] = schema.ndarray(3, ti.i32, (nt,))
         a["tmat"] = ti.ndarray(ti.i32, (nt,))
         a["tsig"] = _arr(4, (nt,))
@@ -658,7 +662,8 @@ class Continuum:
         # everything is rebuilt at the first two steps (cskip's first-step marks
         # go at the second) and after a restore
         pcmm.update(a, e, float(dt), float(sim._time), int(sim.steps == 0),
-                    self._full or sim.steps <= 1, self.carry_stress, self.eos, sim._serial())
+                    self._full or sim.steps <= 1, self.carry_stress, self.eos, sim._serial(),
+                    self.mixed)
         self._full = False
 
     def cell_pressure(self, sim, reach):
@@ -723,8 +728,8 @@ class Continuum:
             return
         a = self.a
         blk.update(a["npos"], a["nvel"], a["tri"], a["tmat"], a["matp"], a["tsig"],
-                   a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nforce"],
-                   float(dt), sim._serial())
+                   a["tstate"], a["tfor"], a["inc_start"], a["inc"], a["nmix"],
+                   a["nforce"], float(dt), self.mixed, sim._serial())
 
     def point_edge(self, sim, dt):
         """Stage: particle–block and block–block point–edge contacts (coupling/),

@@ -205,7 +205,7 @@ class Runner:
             pos, rad, pmat = np.zeros((0, 2)), np.zeros(0), np.zeros(0, np.int64)
         walls = np.array(self._walls_host, float).reshape(-1, stepk.wall_width(self.dim))
         return Continuum(pos, rad, pmat, self._slots, self._blocks, couples=self._couple_rows(),
-                         walls=walls)
+                         walls=walls, mixed=self.mixed_discretization)
 
     def _require_built(self):
         if not self._built:

@@ -145,12 +145,17 @@ class Simulation(Runner, Results):
 
     def __init__(self, gravity=None, dt=None, dt_fraction=0.2, arch=None,
                  precision="f64", local_damping=0.0, global_damping=0.0, skin=None,
-                 check_interval=100, progress=None, threads=None, dim=2, broad_phase="grid"):
+                 check_interval=100, progress=None, threads=None, dim=2, broad_phase="grid",
+                 mixed_discretization=True):
         if dim not in (2, 3) or isinstance(dim, bool):
             raise InputError(f"dim must be 2 or 3, got {dim!r}")
         if broad_phase not in ("grid", "sweep"):
             raise InputError(f"broad_phase must be 'grid' or 'sweep', got {broad_phase!r}")
         self.broad_phase = broad_phase
+        if not isinstance(mixed_discretization, (bool, np.bool_)):
+            raise InputError("mixed_discretization must be True or False, got "
+                             f"{mixed_discretization!r}")
+        self.mixed_discretization = bool(mixed_discretization)
         self.dim = int(dim)
         if gravity is None:
             gravity = (0.0, -9.81) if dim == 2 else (0.0, 0.0, -9.81)

@@ -9,7 +9,7 @@ from .rebuild import copies, displacements, incidence, mark_dirty, rebuild_eleme
 from .stress import eos_volumes, equation_of_state, stresses
 
 
-def update(a, e, dt, time, first, full, carry, eos, serial):
+def update(a, e, dt, time, first, full, carry, eos, serial, mixed=True):
     """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16) for the particles of x_n
     moving at v_{n−1/2}, in the order the data flows. ``a``: the continuum's arrays
     (:class:`tdem.continuum.Continuum`), ``e``: the engine's (positions, velocities,
@@ -41,7 +41,7 @@ def update(a, e, dt, time, first, full, carry, eos, serial):
              a["efor"], a["ede"],
              a["psig"], a["pfail"], a["rad"], a["elem_old"], a["esig_old"], a["ecnt_old"],
              a["esrc"], a["prb"], a["pdirty"], a["unb"], a["pu"], a["pflags"], a["ebase"],
-             a["eidx"], dt, carry, eos, serial)
+             a["eidx"], a["pmix"], dt, carry, eos, bool(mixed), serial)
     if eos:
         equation_of_state(a["pmat"], a["matp"], a["rad"], e["pos"], a["elem"], a["ecnt"],
                           a["emult"], a["pinc"], a["picnt"], a["ncov"], a["sigc"],

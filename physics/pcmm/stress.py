@@ -146,7 +146,9 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
              ecnt_old: ti.types.ndarray(), esrc: ti.types.ndarray(), prb: ti.types.ndarray(),
              pdirty: ti.types.ndarray(), unb: ti.types.ndarray(), pu: ti.types.ndarray(),
              pflags: ti.types.ndarray(), ebase: ti.types.ndarray(), eidx: ti.types.ndarray(),
-             dt: ti.f64, carry: ti.template(), eos: ti.template(), serial: ti.template()):
+             pmix: ti.types.ndarray(),
+             dt: ti.f64, carry: ti.template(), eos: ti.template(), mixed: ti.template(),
+             serial: ti.template()):
     """2. Per computed element: N_e (probe rule; recounted where the elements around
     it changed or its vertices' neighbourhoods moved farther than the count's slack,
     ``ebud``, the same bookkeeping as :func:`rebuild_elements`), σ_old (the element's
@@ -156,7 +158,18 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     correction (Eq. 12), and the record from which the gather makes the nodal
     forces with the weight 1/N_e (Eqs. 13–14, sign fixed; :func:`_record`), in the
     next place of the particle's run of records (``eidx``, :func:`record_slots`);
-    the stress at the same place of ``sigc`` (:func:`copies`)."""
+    the stress at the same place of ``sigc`` (:func:`copies`).
+
+    ``mixed``: the nodal mixed discretization (:mod:`physics.fvm`) for the elements
+    of materials without an equation of state: the volumetric part of each
+    element's strain increment is the mean over its three particles of their
+    averages Σ V_e Δθ_e / Σ V_e over the elements containing them (V_e = k S_e/N_e,
+    the element's share of the area, k its multiplicity), and the in-plane mean
+    stress of its nodal forces the same average of the elements' mean stresses
+    (``pmix`` (N, 2) holds the particles' averages). The passes: (a) N_e, the
+    kinematics and (Δθ, V) per record; (b) the particles' Δθ; (c) the stresses;
+    (d) the particles' mean stresses; (e) the records. Until (e) the record lines
+    ``efor[j]`` hold the passes' data."""
     new = pflags[P_NEW] != 0
     soft = pflags[P_SOFT] != 0
     ti.loop_config(serialize=serial)
@@ -189,33 +202,125 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     ebud[a, s] = sl - (0.0 if soft else uw) - SLACK_FLOOR * rad[a]
                 elif soft:
                     ebud[a, s] -= uw
-                grad, de, area = _kinematics(a, b, c, pos, vel, dt)
-                M = pmat[a]
-                kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
-                sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
-                eps = 0.0
-                flag = 0
-                if kind != JWL_TYPE:
-                    # (a JWL element takes the mean of its particles' pressures: the
-                    # particles carry the equation of state, see the gather below)
-                    found = False
-                    if ti.static(carry):
-                        sig, found = _carried(a, b, c, s, jold, elem, ecnt, esig, sigp,
-                                              elem_old, esig_old, ecnt_old, esrc, prb)
-                    if not found:
-                        sig = (psig[a] + psig[b] + psig[c]) / 3.0
-                    sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
-                        de, matp[M, MAT_K], matp[M, MAT_G])
-                    if kind == FLUID:
-                        sig = relax_shear(sig, matp[M, MAT_FLUID_TAU], dt)
-                    failed = 0
-                    if pfail[a] + pfail[b] + pfail[c] > 0:
-                        failed = 1
-                    sig, eps, flag = mc_correct_state(sig, matp, M, failed)
-                sigc[j] = sig
-                _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp, emult,
-                        efor, ede, dt, eos)
+                if ti.static(mixed):
+                    grad, de, area = _kinematics(a, b, c, pos, vel, dt)
+                    efor[j] = ti.Vector([de[0] + de[1], ti.cast(jold, ti.f64), 0.0,
+                                         ti.cast(cover, ti.f64), 0.0, 0.0, 0.0,
+                                         ti.cast(emult[a, s], ti.f64) * area / cover])
+                else:
+                    _element_stress(a, s, j, jold, cover, 0.0, pos, vel, pmat, matp, elem,
+                                    ecnt, emult, esig, sigp, sigc, efor, ede, psig, pfail,
+                                    elem_old, esig_old, ecnt_old, esrc, prb, dt, carry, eos,
+                                    False)
                 j += 1
+    if ti.static(mixed):
+        ti.loop_config(serialize=serial)
+        for i in range(pmat.shape[0]):
+            pmix[i] = ti.Vector([_particle_mean(i, 0, pmat, matp, inc, icnt, eidx, efor), 0.0])
+        ti.loop_config(serialize=serial)
+        for a in range(pmat.shape[0]):
+            for s in range(ecnt[a]):
+                if emult[a, s] > 0:
+                    j = eidx[a, s]
+                    r = efor[j]
+                    theta = (pmix[a][0] + pmix[elem[a, s, 0]][0] + pmix[elem[a, s, 1]][0]) / 3.0
+                    _element_stress(a, s, j, ti.cast(r[1], ti.i32), ti.cast(r[3], ti.i32),
+                                    theta, pos, vel, pmat, matp, elem, ecnt, emult, esig, sigp,
+                                    sigc, efor, ede, psig, pfail, elem_old, esig_old, ecnt_old,
+                                    esrc, prb, dt, carry, eos, True)
+        ti.loop_config(serialize=serial)
+        for i in range(pmat.shape[0]):
+            pmix[i][1] = _particle_mean(i, 6, pmat, matp, inc, icnt, eidx, efor)
+        ti.loop_config(serialize=serial)
+        for a in range(pmat.shape[0]):
+            for s in range(ecnt[a]):
+                if emult[a, s] > 0:
+                    j = eidx[a, s]
+                    r = efor[j]
+                    b = elem[a, s, 0]
+                    c = elem[a, s, 1]
+                    mean = (pmix[a][1] + pmix[b][1] + pmix[c][1]) / 3.0
+                    de = ti.Vector([r[0], r[1], r[2]])
+                    area = r[7] * r[3] / ti.cast(emult[a, s], ti.f64)
+                    flag = ti.cast(r[5], ti.i32)
+                    _finish(a, s, j, b, c, pmat[a], sigc[j], r[4], flag, de, area,
+                            ti.cast(r[3], ti.i32), matp, emult, efor, ede, dt, eos, True, mean)
+
+
+@ti.func
+def _particle_mean(i, k, pmat: ti.template(), matp: ti.template(), inc: ti.template(),
+                   icnt: ti.template(), eidx: ti.template(), efor: ti.template()):
+    """Σ V_e q_e / Σ V_e over the elements containing particle i, q_e in column k of
+    their record lines and V_e in column 7 (:func:`stresses`, mixed); 0 for a
+    particle of a material with an equation of state, or in no element."""
+    out = 0.0
+    M = pmat[i]
+    if M >= 0:
+        if not _has_eos(matp, M):
+            num = 0.0
+            den = 0.0
+            for q in range(icnt[i]):
+                o, sl = inc_element(inc[i, q])
+                r = efor[eidx[o, sl]]
+                num += r[7] * r[k]
+                den += r[7]
+            if den > 0.0:
+                out = num / den
+    return out
+
+
+@ti.func
+def _element_stress(a, s, j, jold, cover, theta, pos: ti.template(), vel: ti.template(),
+                    pmat: ti.template(), matp: ti.template(), elem: ti.template(),
+                    ecnt: ti.template(), emult: ti.template(), esig: ti.template(),
+                    sigp: ti.template(), sigc: ti.template(), efor: ti.template(),
+                    ede: ti.template(), psig: ti.template(), pfail: ti.template(),
+                    elem_old: ti.template(), esig_old: ti.template(),
+                    ecnt_old: ti.template(), esrc: ti.template(), prb: ti.template(), dt,
+                    carry: ti.template(), eos: ti.template(), mixed: ti.template()):
+    """The stress update of the element in a's slot s (record j; ``jold`` last step's
+    record of the slot, ``cover`` its N_e): Eqs. 6–12, into ``sigc[j]``. Not
+    ``mixed``: the record follows (:func:`_finish`). ``mixed``: the strain
+    increment's volumetric part is ``theta`` (for a material without an equation of
+    state), and ``efor[j]`` keeps (Δε, N_e, Δe^ps, flag, in-plane mean stress of the
+    forces, V_e) for the passes that follow (:func:`stresses`)."""
+    b = elem[a, s, 0]
+    c = elem[a, s, 1]
+    grad, de, area = _kinematics(a, b, c, pos, vel, dt)
+    M = pmat[a]
+    kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
+    if ti.static(mixed):
+        if not _has_eos(matp, M):
+            de = fvm.mixed_strain(de, theta)
+    sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
+    eps = 0.0
+    flag = 0
+    if kind != JWL_TYPE:
+        # (a JWL element takes the mean of its particles' pressures: the
+        # particles carry the equation of state, see the gather below)
+        found = False
+        if ti.static(carry):
+            sig, found = _carried(a, b, c, s, jold, elem, ecnt, esig, sigp,
+                                  elem_old, esig_old, ecnt_old, esrc, prb)
+        if not found:
+            sig = (psig[a] + psig[b] + psig[c]) / 3.0
+        sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+            de, matp[M, MAT_K], matp[M, MAT_G])
+        if kind == FLUID:
+            sig = relax_shear(sig, matp[M, MAT_FLUID_TAU], dt)
+        failed = 0
+        if pfail[a] + pfail[b] + pfail[c] > 0:
+            failed = 1
+        sig, eps, flag = mc_correct_state(sig, matp, M, failed)
+    sigc[j] = sig
+    if ti.static(mixed):
+        sf = _force_stress(matp, M, sig, de, dt, area)
+        efor[j] = ti.Vector([de[0], de[1], de[2], ti.cast(cover, ti.f64), eps,
+                             ti.cast(flag, ti.f64), 0.5 * (sf[0] + sf[1]),
+                             ti.cast(emult[a, s], ti.f64) * area / cover])
+    else:
+        _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp, emult, efor, ede,
+                dt, eos, False, 0.0)
 
 
 @ti.func
@@ -231,13 +336,26 @@ def _kinematics(a, b, c, pos: ti.template(), vel: ti.template(), dt):
 
 
 @ti.func
+def _force_stress(matp: ti.template(), M, sig, de, dt, area):
+    """The stress of an element's nodal forces: its stress, with the viscous stress
+    and the artificial bulk viscosity (a material with an equation of state: the
+    stress, which :func:`equation_of_state` replaces)."""
+    sf = sig
+    if not _has_eos(matp, M):
+        q = bulk_viscosity(matp, M, de, dt, area)
+        sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
+    return sf
+
+
+@ti.func
 def _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp: ti.template(),
             emult: ti.template(), efor: ti.template(), ede: ti.template(), dt,
-            eos: ti.template()):
+            eos: ti.template(), mixed: ti.template(), mean):
     """The end of step 2 for element (a, s) with its corrected stress: the state
     the equation of state reads (``ede``), the stress of its nodal forces
-    (artificial bulk viscosity and viscous stress included) and the gather's record
-    (``efor``), from which the gather makes the forces."""
+    (artificial bulk viscosity and viscous stress included; ``mixed``: its in-plane
+    mean replaced by ``mean``) and the gather's record (``efor``), from which the
+    gather makes the forces."""
     q = bulk_viscosity(matp, M, de, dt, area)
     if ti.static(eos):
         ede[a, s] = ti.Vector([de[0], de[1], de[2], eps, ti.cast(flag, ti.f64),
@@ -245,7 +363,9 @@ def _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp: ti.template
     sf = sig
     wf = 0.0
     if not _has_eos(matp, M):
-        sf = sig + viscous_stress(matp, M, de, dt) + ti.Vector([-q, -q, 0.0, 0.0])
+        sf = _force_stress(matp, M, sig, de, dt, area)
+        if ti.static(mixed):
+            sf = fvm.mixed_stress(sf, mean)
         wf = 1.0 / cover
     _record(efor, j, sig, sf, wf, de, eps, flag, emult[a, s], b, c)
 
