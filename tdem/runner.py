@@ -36,7 +36,7 @@ from . import state as schema
 from . import step as stepk
 from .continuum import Continuum
 from .errors import CapacityError, InputError, InstabilityError
-from .neighbors import F_BAD, F_NEED, F_REBUILD, F_SWEEP, F_WALL_NEED, FLAGS_SIZE
+from .neighbors import F_BAD, F_FAST, F_NEED, F_REBUILD, F_SWEEP, F_WALL_NEED, FLAGS_SIZE
 
 
 MAX_SLOTS = 1024
@@ -727,9 +727,33 @@ class Runner:
         a = self._a
         if self._n == 0:
             return np.array([0, 0, 0, 0, 0, 0, 0, 0], np.int32)
-        stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["flags"],
-                              float(self._dt_run), self.dim)
-        return launch.host_copy(a["flags"])
+        # the overlap limit for plain DEM models (PCMM and water particles overlap by
+        # design; their elements and nodes have their own checks)
+        limit = stepk.OVERLAP_LIMIT if self._cont is None else 0.0
+        stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["nbr"], a["ncnt"],
+                              a["cs"], a["flags"], float(self._dt_run), limit, self.dim)
+        flags = launch.host_copy(a["flags"])
+        if (0 < flags[F_FAST] <= self._n and flags[F_BAD] >= self._n
+                and not getattr(self, "_fast_warned", False)):
+            self._warn_fast(int(flags[F_FAST]) - 1)
+        return flags
+
+    def _warn_fast(self, k):
+        """Say once that particle k has moved more than its radius in one step (free
+        flight, ejecta: not an instability, but it may pass through a thin neighbour
+        or a wall within a step)."""
+        self._fast_warned = True
+        v = launch.host_copy(self._a["vel"])[k]
+        r = float(launch.host_copy(self._a["prop"])[k][0])
+        dt = self._dt_run
+        speed = float(np.linalg.norm(v))
+        warnings.warn(
+            f"particle {k} moved more than its radius ({r:.4g} m) in one step: faster than "
+            f"{r / dt:.4g} m/s at dt = {dt:.4g} s (its speed at t = {self._time:.6g} s: "
+            f"{speed:.4g} m/s, {speed * dt / r:.3g} radii a step). Not an instability, but "
+            f"it may pass through a neighbour or a wall within a step without touching it; "
+            f"a smaller dt (below {r / max(speed, r / dt):.3g} s at that speed) keeps its "
+            "steps within its radius (said once)", RuntimeWarning, stacklevel=5)
 
     def _warn_dense_packing(self, dt):
         """Warn when the step exceeds the stable step of a dense packing of the
