@@ -10,7 +10,6 @@ radius (tests/test_inputs.py, tests/test_stable_dt.py)."""
 import math
 import warnings
 
-import numpy as np
 import pytest
 
 import tdem
