@@ -3,14 +3,22 @@ averages: the Love–Weber stress, porosity, coordination number and fabric tens
 the particles whose centres lie in a box, a circle or a polygon (2D), or a box or a
 sphere (3D).
 
-For the particles p in the region (area, in 3D volume, V):
+For the particles p whose centres lie in the region (area, in 3D volume, V):
 
-- stress σ = (1/V) Σ_p Σ_c sym((x_c − x_p) ⊗ f_c), f_c the force of contact c on p
-  at its contact point x_c (particle and wall contacts), tension-positive (Love 1927,
-  Weber 1966). Over a region that holds a whole specimen in equilibrium it is the
-  stress its boundary carries; the pairs inside a region count once from each side;
-- porosity 1 − Σ_p V_p / V (a particle counts whole where its centre lies; V_p its
-  area in 2D, its volume m_p/ρ_p in 3D);
+- porosity n = 1 − Σ_q |q ∩ region| / V over every particle q: the part of each
+  disc or sphere inside the region, exact (:mod:`tdem.overlap_volume`: disc–box,
+  disc–polygon, disc–circle, sphere–sphere closed forms; sphere–box by converged
+  quadrature), the periodic images included. Superellipses, ellipsoids and
+  polyhedra count whole where their centres lie (their intersection with the region
+  is not worked out);
+- stress σ = (1 − n)/(Σ_p V_p) Σ_p Σ_c sym((x_c − x_p) ⊗ f_c), V_p the area of p
+  in 2D, its volume m_p/ρ_p in 3D, f_c the force of contact c on p at its contact
+  point x_c (particle and wall contacts), tension-positive: the Love–Weber sum
+  (Love 1927, Weber 1966) of the particles whose centres are inside, scaled by the
+  solid they stand for, as PFC's measurement circles do. Dividing the sum by V
+  instead would weigh the region by how many centres happen to fall in it. Over a
+  region that holds a whole specimen in equilibrium it is the stress its boundary
+  carries; the pairs inside a region count once from each side;
 - coordination: the mean number of contacts (with particles and walls) of the
   particles in the region;
 - fabric φ = (1/N_c) Σ_c n_c ⊗ n_c over the contacts of those particles (trace 1).
@@ -18,10 +26,12 @@ For the particles p in the region (area, in 3D volume, V):
 Contacts carried by PCMM elements are not contacts here (their stress is the
 particles' ``stress``).
 """
+import itertools
 import math
 
 import numpy as np
 
+from . import overlap_volume as ov
 from .errors import InputError
 from .pack import _polygon_area
 
@@ -88,6 +98,42 @@ class Region:
         return self.path.contains_points(x)
 
 
+def _solid_inside(region, pos, radius, periodic):
+    """Σ of the areas (3D: volumes) of the discs (spheres) inside the region, their
+    images across the periodic axes included."""
+    dim = region.dim
+    if region.kind == "box":
+        lo, hi = region.lo, region.hi
+    elif region.kind == "polygon":
+        v = region.path.vertices
+        lo, hi = v.min(axis=0), v.max(axis=0)
+    else:
+        lo, hi = region.c - region.r, region.c + region.r
+    spans = [(0.0,)] * dim
+    for k, span in enumerate(list(periodic)[:dim]):
+        if span is not None:
+            length = span[1] - span[0]
+            spans[k] = (0.0, -length, length)
+    total = 0.0
+    for shift in itertools.product(*spans):
+        x = pos + np.asarray(shift)
+        near = np.all((x + radius[:, None] > lo) & (x - radius[:, None] < hi), axis=1)
+        if not near.any():
+            continue
+        x, r = x[near], radius[near]
+        if region.kind == "box":
+            part = (ov.disc_box_area(x, r, lo, hi) if dim == 2
+                    else ov.sphere_box_volume(x, r, lo, hi))
+        elif region.kind == "polygon":
+            part = ov.disc_polygon_area(x, r, region.path.vertices)
+        elif dim == 2:
+            part = ov.disc_disc_area(x, r, region.c, region.r)
+        else:
+            part = ov.sphere_sphere_volume(x, r, region.c, region.r)
+        total += float(np.sum(part))
+    return total
+
+
 def measure(sim, box=None, circle=None, polygon=None, sphere=None):
     """The measurements of the module docstring for ``sim`` now: a dict with stress
     (d, d) Pa (N/m² per metre of thickness in 2D), porosity, coordination, fabric
@@ -123,19 +169,26 @@ def measure(sim, box=None, circle=None, polygon=None, sphere=None):
     if any(q is not None for q in getattr(sim, "_periodic", ())):
         arm = sim._image(arm)       # the contact point seen from the owner's side
     s = np.einsum("ca,cb->ab", arm, force)
-    stress = 0.5 * (s + s.T) / region.area
     npart = int(inside.sum())
     ncont = len(owner)
     fabric = (np.einsum("ca,cb->ab", normal, normal) / ncont) if ncont else np.zeros((dim, dim))
+    rows = np.concatenate(sim._host["shape"]) if sim._has_shapes else None
     if dim == 2:
         size = math.pi * p["radius"] ** 2
-        if sim._n and sim._has_shapes:
-            rows = np.concatenate(sim._host["shape"])
-            size = np.where(rows[:, 2] > 0, rows[:, 3], size)     # a shape's own area
+        shaped = rows[:, 2] > 0 if rows is not None else np.zeros(len(size), bool)
+        size = np.where(shaped, rows[:, 3], size) if rows is not None else size
     else:
         size = p["mass"] / np.concatenate(sim._host["density"])   # spheres, ellipsoids, polyhedra
-    solid = float(np.sum(size[inside]))
-    out = {"stress": stress, "porosity": 1.0 - solid / region.area,
+        shaped = rows[:, 3] != 0 if rows is not None else np.zeros(len(size), bool)
+    solid = float(np.sum(size[inside & shaped]))
+    round_ = ~shaped
+    solid += _solid_inside(region, p["position"][round_], p["radius"][round_],
+                           getattr(sim, "_periodic", ()))
+    porosity = 1.0 - solid / region.area
+    held = float(np.sum(size[inside]))
+    scale = (1.0 - porosity) / held if held > 0.0 else 0.0
+    stress = 0.5 * (s + s.T) * scale
+    out = {"stress": stress, "porosity": porosity,
            "coordination": ncont / npart if npart else 0.0, "fabric": fabric,
            "particles": npart, "contacts": ncont, "area": region.area}
     if dim == 3:

@@ -13,7 +13,13 @@ carried over from the previous list whenever the pair is still listed.
 The lists are rebuilt only when some particle has moved more than half the skin
 since the last build; the integrator raises a flag on the device. On the GPU the
 rebuild kernel is launched every step and does nothing unless the flag is up; on
-the CPU the host reads the flag (shared memory, no transfer).
+the CPU the host reads the flag (shared memory, no transfer). The test is on the
+displacement since the build, and the build comes before the next force evaluation:
+a particle faster than half the skin per step has its lists made anew at every
+step, so no pair within reach at the start of a step is missed, however fast. What
+the lists cannot see is a pair crossed within one step (a particle moving more than
+its radius in a step may pass through a thin neighbour or a wall): the status check
+reports such a particle once (flags[F_FAST], Runner._status).
 
 Each particle also lists its candidate walls (within R + skin); a wall that has
 moved half the skin since the build raises the flag too, so relative motion never
@@ -46,7 +52,12 @@ F_TBIN_NEED = 6  # 3D: entries the triangle bins needed (more than their capacit
 F_TBIN_TOTAL = 7  # 3D: entries of the triangle bins at the last build
 F_SWEEP = 8      # sort-and-sweep (tdem.sweep): 1 while its pair set matches its sorted
                  # axes; 0 asks the next build to make the set again from the axes
-FLAGS_SIZE = 9
+F_FAST = 9       # 1 + the largest index of a particle that moved more than its radius in
+                 # one step (0: none so far; tdem.step.step raises it, the host reports it)
+F_PUSH = 10      # 1 + the largest index of a particle that the forces of a step pushed
+                 # past what a stable step does (tdem.step.step; 0: none): folded into
+                 # F_BAD and cleared by the status check (tdem.step.check_stability)
+FLAGS_SIZE = 11
 
 # columns of the float parameter array ``simp`` (the step's and the search's)
 P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6

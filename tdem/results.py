@@ -288,7 +288,9 @@ class Results:
         step ahead of the stored energy; that offset, ½ Δt F·v of the last step, is
         taken out (for a linear spring the line is then zero: the leapfrog keeps its
         discrete energy exactly). kinetic and gravitational are the particles'
-        (blocks' nodes are in :meth:`work`)."""
+        (blocks' nodes are in :meth:`work`). Before the first step they are those of
+        the state as given (½ m v² + ½ ω·L, −m g·x); the contact springs are first
+        evaluated by the first step (elastic 0 until then)."""
         if not self._built:
             self._build()
         e = self._account_now()
@@ -362,6 +364,12 @@ class Results:
                 turned = a["shp"].to_numpy()[:, 3] != 0.0
                 iw2[turned] = np.einsum("ij,ij->i", w[turned], a["lmom"].to_numpy()[turned])
             e["ke_half"] = float(0.5 * np.sum(prop[:, 1] * np.einsum("ij,ij->i", v, v) + iw2))
+            if self._steps == 0:
+                # before the first step the step kernel has stored nothing: the state
+                # at t = 0 is the particles' as given, ½ m v² + ½ ω·L and −m g·x
+                e["kinetic"] = e["ke_half"]
+                g = np.asarray(self.gravity, dtype=float)[:self.dim]
+                e["gravitational"] = float(-np.sum(prop[:, 1] * (a["pos"].to_numpy() @ g)))
             # ½ Δt F_n·v_{n+1/2} of the contact and element forces of the last step:
             # the half step by which the booked work runs ahead of the stored energy
             f = a["force"].to_numpy()

@@ -36,7 +36,7 @@ from . import state as schema
 from . import step as stepk
 from .continuum import Continuum
 from .errors import CapacityError, InputError, InstabilityError
-from .neighbors import F_BAD, F_NEED, F_REBUILD, F_SWEEP, F_WALL_NEED, FLAGS_SIZE
+from .neighbors import F_BAD, F_FAST, F_NEED, F_REBUILD, F_SWEEP, F_WALL_NEED, FLAGS_SIZE
 
 
 MAX_SLOTS = 1024
@@ -727,9 +727,33 @@ class Runner:
         a = self._a
         if self._n == 0:
             return np.array([0, 0, 0, 0, 0, 0, 0, 0], np.int32)
-        stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["flags"],
-                              float(self._dt_run), self.dim)
-        return launch.host_copy(a["flags"])
+        # the overlap limit for plain DEM models (PCMM and water particles overlap by
+        # design; their elements and nodes have their own checks)
+        limit = stepk.OVERLAP_LIMIT if self._cont is None else 0.0
+        stepk.check_stability(a["pos"], a["vel"], a["omega"], a["prop"], a["nbr"], a["ncnt"],
+                              a["cs"], a["flags"], float(self._dt_run), limit, self.dim)
+        flags = launch.host_copy(a["flags"])
+        if (0 < flags[F_FAST] <= self._n and flags[F_BAD] >= self._n
+                and not getattr(self, "_fast_warned", False)):
+            self._warn_fast(int(flags[F_FAST]) - 1)
+        return flags
+
+    def _warn_fast(self, k):
+        """Say once that particle k has moved more than its radius in one step (free
+        flight, ejecta: not an instability, but it may pass through a thin neighbour
+        or a wall within a step)."""
+        self._fast_warned = True
+        v = launch.host_copy(self._a["vel"])[k]
+        r = float(launch.host_copy(self._a["prop"])[k][0])
+        dt = self._dt_run
+        speed = float(np.linalg.norm(v))
+        warnings.warn(
+            f"particle {k} moved more than its radius ({r:.4g} m) in one step: faster than "
+            f"{r / dt:.4g} m/s at dt = {dt:.4g} s (its speed at t = {self._time:.6g} s: "
+            f"{speed:.4g} m/s, {speed * dt / r:.3g} radii a step). Not an instability, but "
+            f"it may pass through a neighbour or a wall within a step without touching it; "
+            f"a smaller dt (below {r / max(speed, r / dt):.3g} s at that speed) keeps its "
+            "steps within its radius (said once)", RuntimeWarning, stacklevel=5)
 
     def _warn_dense_packing(self, dt):
         """Warn when the step exceeds the stable step of a dense packing of the
@@ -900,26 +924,83 @@ class Runner:
             detail = s == n - 1 or self._steps + 1 >= self._next_event or first
             self._one_step(sargs, rargs, host_flag, detail)
             if first:
+                # a step made with lists too short is redone: its account is not taken
+                # (its state may hold anything, non-finite numbers included)
+                if self._grown_if_short(launch.host_copy(self._a["flags"]) if self._n
+                                        else None):
+                    return
                 self._account0 = self._account_now()
+                self._warn_silent_models()
             if self._steps >= self._next_event:
                 self._events()
         flags = self._status()
-        if self._cont is not None:
-            need, bad = self._cont.status()
-            if self._cont.short(need):
-                self._restore_snapshot()
-                self._cont.grow(need)
-                return
-            if bad >= 0:
-                self._find_instability()
-        if self._n and (flags[F_NEED] > self._cap or flags[F_WALL_NEED] > self._capw):
-            self._restore_snapshot()
-            self._grow(flags)
+        if self._grown_if_short(flags):
             return
+        if self._cont is not None and self._cont.status()[1] >= 0:
+            self._find_instability()
         if flags[F_BAD] < self._n:
             self._find_instability()
         if self._n and self._steps - self._last_fit >= self.check_interval:
             self._fit_grid()
+
+    def _warn_silent_models(self):
+        """Once, after the first step (the PCMM elements are made then): a body whose
+        tolerance made (almost) no elements (under a tenth of its Delaunay triangles)
+        runs as loose discs; element water (a Fluid without ``voronoi=True``) on a
+        hexagonal lattice, under gravity, carries only part of ρgh. Each warning
+        gives the elements made and what to change."""
+        if getattr(self, "_silent_checked", False):
+            return
+        self._silent_checked = True
+        if self._cont is None or not self._cont.has_pcmm:
+            return
+        from physics.materials import Fluid
+        body = np.concatenate(self._host["mat"]).astype(np.int64)
+        pos = np.concatenate(self._host["pos"])
+        rad = np.concatenate(self._host["radius"])
+        tri = self._cont.elements()["triangles"]
+        made = np.bincount(body[tri[:, 0]], minlength=len(self._slots)) if len(tri) else \
+            np.zeros(len(self._slots), np.int64)
+        for k, (mat, tol) in enumerate(self._slots):
+            ids = np.flatnonzero(body == k)
+            if tol is None or len(ids) < 3 or (isinstance(mat, Fluid) and mat.voronoi):
+                continue
+            name = type(mat).__name__
+            need, full, hexagonal = _delaunay_elements(pos[ids], rad[ids])
+            if full is not None and made[k] < 0.1 * full:
+                r = float(np.median(rad[ids]))
+                warnings.warn(
+                    f"PCMM body of material {name} (tolerance {tol:.4g} m, {len(ids)} "
+                    f"particles) made {int(made[k])} elements, where its "
+                    f"{full} Delaunay triangles would make one each: "
+                    f"{'it runs as loose discs' if made[k] == 0 else 'most of it runs as loose discs'}. "
+                    f"Eq. 1 joins particles with d <= R_i + R_j + tolerance; the diagonals "
+                    f"of its lattice need tolerance >= {need:.4g} m ({need / r:.3g} R): raise "
+                    f"the tolerance to at least that", RuntimeWarning, stacklevel=5)
+            elif (isinstance(mat, Fluid) and hexagonal > 0.5
+                  and float(np.linalg.norm(self.gravity)) > 0.0):
+                warnings.warn(
+                    f"PCMM body of material Fluid ({len(ids)} particles, {int(made[k])} "
+                    f"elements): element water (Fluid without voronoi=True) carries only "
+                    f"40–60 % of the hydrostatic pressure ρgh on a hexagonal lattice; "
+                    f"Fluid(..., voronoi=True) gives each particle the pressure of its "
+                    f"Voronoi cell, which carries it", RuntimeWarning, stacklevel=5)
+
+    def _grown_if_short(self, flags):
+        """When the steps since the snapshot overflowed a list (PCMM candidates, the
+        particles' or the walls' slots): the snapshot restored, the lists grown, True
+        (the steps are then redone)."""
+        if self._cont is not None:
+            need, _ = self._cont.status()
+            if self._cont.short(need):
+                self._restore_snapshot()
+                self._cont.grow(need)
+                return True
+        if self._n and (flags[F_NEED] > self._cap or flags[F_WALL_NEED] > self._capw):
+            self._restore_snapshot()
+            self._grow(flags)
+            return True
+        return False
 
     def _find_instability(self):
         """Replay the last segment one step at a time to name the failing step."""
@@ -999,6 +1080,32 @@ class Runner:
         from tqdm.auto import tqdm
         return tqdm(total=total, unit="step", desc=f"tdem (dt {self._dt_run:.3g} s)",
                     leave=False)
+
+
+def _delaunay_elements(pos, rad):
+    """Of the Delaunay triangles of a body's particles: (the tolerance at which they
+    become elements, the median over the triangles of their largest gap d − R_i −
+    R_j; their number; the share of them that are equilateral within 10 %, a
+    hexagonal lattice's). (0, None, 0) when the points make no triangulation."""
+    from scipy.spatial import Delaunay, QhullError
+    try:
+        tri = Delaunay(pos).simplices
+    except (QhullError, ValueError):
+        return 0.0, None, 0.0
+    gap = np.zeros(len(tri))
+    side = []
+    for a, b in ((0, 1), (1, 2), (0, 2)):
+        i, j = tri[:, a], tri[:, b]
+        d = np.linalg.norm(pos[i] - pos[j], axis=1)
+        side.append(d)
+        gap = np.maximum(gap, d - rad[i] - rad[j])
+    # slivers along a convex hull make no element whatever the tolerance: leave them out
+    keep = gap <= 2.0 * float(np.median(rad))
+    if not keep.any():
+        return 0.0, None, 0.0
+    side = np.stack(side, axis=1)[keep]
+    equilateral = float(np.mean(side.max(axis=1) <= 1.1 * side.min(axis=1)))
+    return float(np.median(gap[keep])), int(keep.sum()), equilateral
 
 
 def _duration(seconds):

@@ -28,7 +28,7 @@ from physics.rolling import (rolling_couple, rolling_couple_3d, rolling_energy,
 from .finite import any_non_finite, non_finite
 from .integrate import _quat_mul, damped_leapfrog, free_rotation
 from .launch import cached
-from .neighbors import (F_BAD, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_CHUNK,  # noqa: F401
+from .neighbors import (F_BAD, F_FAST, F_PUSH, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_CHUNK,  # noqa: F401
                         P_DT, P_GX, P_GY, P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0,
                         P_PZ0, P_SKIN, SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH,
                         T_OX, T_VX, T_WX, TRI_WIDTH, gravity, image, periodic_axes, slot_bits,
@@ -45,6 +45,14 @@ from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
  W_SERVO_K, W_SERVO_F, W_SERVO_DX, W_SERVO_DY, W_SERVO_ALPHA, W_SERVO_VMAX) = range(18)
 WALL_WIDTH = 18
 # 3D: the wall table holds the triangles of the mesh walls (columns T_*, tdem.neighbors)
+
+# the contact forces of a step may move a particle by at most this fraction of its
+# radius (turn it by this many radians) from rest in one step; more is an instability
+# (check_stability)
+PUSH_LIMIT = 1.0
+# a pair whose overlap exceeds this fraction of the smaller radius (the smaller's centre
+# inside the other) has failed: the model is unstable (check_stability; DEM models only)
+OVERLAP_LIMIT = 1.0
 
 
 def wall_width(dim):
@@ -865,6 +873,16 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         dx = x1 - xref[i]
         if dx.dot(dx) > half_skin2:
             flags[F_REBUILD] = 1
+        # a step longer than the radius: said once by the host (Runner._status)
+        r_i = prop[i][PROP_RADIUS]
+        if v1.dot(v1) * dt * dt > r_i * r_i:
+            ti.atomic_max(flags[F_FAST], i + 1)
+        # forces that would move the particle more than PUSH_LIMIT radii (turn it more
+        # than PUSH_LIMIT rad) in one step from rest: unstable (check_stability)
+        fp = fc + fx_cont
+        if (fp.norm() * dt * dt > PUSH_LIMIT * r_i * m
+                or ti.sqrt(spin_dot(tc, tc, dim)) * dt * dt > PUSH_LIMIT * inertia):
+            ti.atomic_max(flags[F_PUSH], i + 1)
 
     # 3. each wall's force: its chunks' partial sums added in their order (a fixed
     #    order, whichever thread ran a chunk). Then the walls move: servo walls first
@@ -1036,9 +1054,25 @@ def largest_overlap_ratio(cs: ti.types.ndarray(), nbr: ti.types.ndarray(),
 @ti.kernel
 def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                     omega: ti.types.ndarray(), prop: ti.types.ndarray(),
-                    flags: ti.types.ndarray(), dt: ti.f64, dim: ti.template()):
-    """flags[F_BAD] = smallest index of a particle with a non-finite state or moving
-    more than half its radius in one step."""
+                    nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), cs: ti.types.ndarray(),
+                    flags: ti.types.ndarray(), dt: ti.f64, overlap_limit: ti.f64,
+                    dim: ti.template()):
+    """The status of the last step (its forces and overlaps are those of a recording
+    step: the last of a segment, every step of a replay).
+
+    flags[F_BAD] = smallest index of an unstable particle: a non-finite state; or,
+    with ``overlap_limit`` > 0, a pair overlapping by more than that fraction of the
+    smaller radius (the smaller one's centre inside the other: past what a contact
+    holds; the owner of the pair's slot is named); or
+    the particle the steps since the last check found pushed too hard (flags[F_PUSH],
+    then cleared): contact and element forces that would move it more than
+    PUSH_LIMIT × its radius in one step from rest, |F| Δt²/m > R (or turn it by more
+    than PUSH_LIMIT rad, |M| Δt²/I > 1). A stable integration of a contact never does
+    (its force is k δ with k Δt²/m < 4 and δ a fraction of R); a step far above the
+    stable one makes it grow without bound.
+
+    A particle moving more than its radius in one step is not unstable (free flight,
+    ejecta, a jet): the step raises flags[F_FAST] for it, and the host says so once."""
     n = pos.shape[0]
     flags[F_BAD] = n
     for i in range(n):
@@ -1055,10 +1089,18 @@ def check_stability(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
             nw = any_non_finite(w)
         # a bit test: under fast math, `s != s` is folded to False (tdem.finite)
         bad = any_non_finite(x) + any_non_finite(v) + nw > 0 or ti.abs(s) > 1e300
-        if not bad:
-            bad = v.norm() * dt > 0.5 * prop[i][PROP_RADIUS]
+        ri = prop[i][PROP_RADIUS]
+        if not bad and overlap_limit > 0.0:
+            for k in range(ncnt[i]):
+                if cs[i, k][2] > overlap_limit * ti.min(ri, prop[nbr[i, k]][PROP_RADIUS]):
+                    bad = True
         if bad:
             ti.atomic_min(flags[F_BAD], i)
+    ti.loop_config(serialize=True)
+    for _ in range(1):
+        if flags[F_PUSH] > 0:
+            ti.atomic_min(flags[F_BAD], flags[F_PUSH] - 1)
+        flags[F_PUSH] = 0
 
 
 @ti.kernel

@@ -134,22 +134,29 @@ def test_unstable_run_leaves_last_good_state(tmp_path):
     sim.monitor("kinetic", lambda s: s.energy()["kinetic"], every=50)
     out = sim.output(tmp_path, every=100)
     sim.run(steps=200)
-    # a disc shot at 1e6 m/s moves far more than half its radius in one step
-    sim.add_particles([[0.1, 0.6]], 0.01, contact=sim._groups[0].contact,
-                      velocity=(1e6, 0.0))
-    with pytest.raises(tdem.InstabilityError) as err:
-        sim.run(steps=300)
-    assert err.value.step == 201 and err.value.particle == 100
+    # two discs overlapping by 0.6 R with a contact of k Δt²/m = 2.8 (the step kept,
+    # just below the critical step of the smallest disc, R = 0.009 m, with it): its
+    # force would move each 1.7 R in one step (the larger index of the two is named)
+    dt = sim.dt
+    sim.dt = dt
+    m = 2500.0 * np.pi * 0.009 ** 2
+    stiff = tdem.LinearContact(kn=3.5 * m / dt ** 2)
+    sim.add_particles([[0.1, 0.6], [0.114, 0.6]], 0.01, contact=stiff, velocity=(1e-3, 0.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)     # above the dense packing's step
+        with pytest.raises(tdem.InstabilityError) as err:
+            sim.run(steps=300)
+    assert err.value.step == 201 and err.value.particle == 101
     assert sim.steps == 200
 
     assert (tmp_path / "last_good.h5").exists() and (tmp_path / "monitors.h5").exists()
     with h5py.File(tmp_path / "last_good.h5", "r") as f:
         assert f.attrs["abort_reason"] == "unstable"
     good = tdem.Simulation.load(tmp_path / "last_good.h5")
-    assert good.steps == 200 and good.time == sim.time and good.n_particles == 101
+    assert good.steps == 200 and good.time == sim.time and good.n_particles == 102
     for key in ("position", "velocity", "omega"):
         assert np.array_equal(good.particles.numpy()[key], sim.particles.numpy()[key]), key
-    assert good.particles.numpy()["velocity"][100, 0] == 1e6
+    assert good.particles.numpy()["velocity"][100, 0] == 1e-3
 
     hist = read_monitors(tmp_path / "monitors.h5")
     t, v = sim.histories()["kinetic"]

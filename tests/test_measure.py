@@ -65,8 +65,11 @@ def test_porosity_coordination_and_fabric(pack):
     m = sim.measure(circle=(centre, 0.08))
     inside = np.sum((p["position"] - centre) ** 2, axis=1) <= 0.08 ** 2
     assert m["particles"] == int(inside.sum())
-    assert m["porosity"] == pytest.approx(
-        1.0 - np.sum(math.pi * p["radius"][inside] ** 2) / (math.pi * 0.08 ** 2), rel=1e-12)
+    # porosity from the part of every disc inside the circle: the lens, as two
+    # circular segments cut by the common chord
+    solid = _lens_areas(np.linalg.norm(p["position"] - centre, axis=1), p["radius"], 0.08)
+    assert m["porosity"] == pytest.approx(1.0 - solid.sum() / (math.pi * 0.08 ** 2),
+                                          rel=1e-12)
     # the contacts of the particles inside, each counted from each of its particles inside
     ids = np.flatnonzero(inside)
     count = np.isin(c["pairs"][:, 0], ids).sum() + np.isin(c["pairs"][:, 1], ids).sum()
@@ -80,6 +83,38 @@ def test_porosity_coordination_and_fabric(pack):
     mb, mp = sim.measure(box=b), sim.measure(polygon=poly)
     np.testing.assert_allclose(mp["stress"], mb["stress"], rtol=1e-12)
     assert mp["porosity"] == pytest.approx(mb["porosity"], rel=1e-12)
+
+
+def _segment(r, h):
+    """Area of the segment of a circle of radius r cut at distance h from its centre."""
+    h = np.clip(h, -r, r)
+    return r * r * np.arccos(h / r) - h * np.sqrt(r * r - h * h)
+
+
+def _lens_areas(d, r, rc):
+    """Area of discs of radius r at distance d from the centre of a circle of radius
+    rc inside it: whole, nothing, or two segments cut by the common chord."""
+    d = np.asarray(d, float)
+    a = np.where(d <= rc - r, math.pi * r * r, 0.0)
+    lens = (d > rc - r) & (d < rc + r)
+    x = (d[lens] ** 2 + rc ** 2 - r[lens] ** 2) / (2.0 * d[lens])   # chord from the centre
+    a[lens] = _segment(rc, x) + _segment(r[lens], d[lens] - x)
+    return a
+
+
+def _lens_volumes(d, r, rc):
+    """Volume of spheres of radius r at distance d from the centre of a sphere of
+    radius rc inside it: whole, nothing, or two caps cut by the common plane."""
+    d = np.asarray(d, float)
+    r = np.broadcast_to(r, d.shape)
+    v = np.where(d <= rc - r, 4.0 / 3.0 * math.pi * r ** 3, 0.0)
+    lens = (d > rc - r) & (d < rc + r)
+    x = (d[lens] ** 2 + rc ** 2 - r[lens] ** 2) / (2.0 * d[lens])
+
+    def cap(R, h):                        # cap of height h of a sphere of radius R
+        return math.pi * h * h * (3.0 * R - h) / 3.0
+    v[lens] = cap(rc, rc - x) + cap(r[lens], r[lens] - (d[lens] - x))
+    return v
 
 
 @pytest.mark.parametrize("kw, match", [
@@ -137,9 +172,15 @@ def test_3d_love_weber_stress_of_a_pressed_cubic_lattice():
     r = 1.1 * a
     s = sim.measure(sphere=((centre, centre, centre), r))
     assert s["particles"] == 7
+    # the seven centres inside carry 7 F a on the diagonal; scaled by the solid inside
+    # (the caps of the spheres cut by the region) over their seven volumes
     vol = 4.0 / 3.0 * math.pi * r ** 3
-    np.testing.assert_allclose(s["stress"], -7.0 * F * a / vol * np.eye(3),
-                               atol=1e-9 * F * a / vol)
+    pos = sim.particles.numpy()["position"]
+    solid = _lens_volumes(np.linalg.norm(pos - centre, axis=1), R, r).sum()
+    assert s["porosity"] == pytest.approx(1.0 - solid / vol, rel=1e-12)
+    vs = 4.0 / 3.0 * math.pi * R ** 3
+    want = -7.0 * F * a * (solid / vol) / (7.0 * vs)
+    np.testing.assert_allclose(s["stress"], want * np.eye(3), atol=1e-9 * abs(want))
 
 
 def test_3d_measure_of_a_pressed_lattice_of_ellipsoids():

@@ -234,10 +234,13 @@ def test_momentum_conserved_while_elements_die_and_are_born(chunks, monkeypatch)
     assert np.abs(p1 - p0).max() < 1e-10 * scale
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")
 def test_candidate_slots_grow_and_steps_are_redone():
     """The PCMM candidate lists start too short (2 slots): the segment is restored from
     its snapshot, the lists grow and the steps are redone; positions, element stresses
-    and particle stresses equal those of a run that started with enough slots."""
+    and particle stresses equal those of a run that started with enough slots. The
+    energy account is not taken from the first step made with the short lists (its
+    state is thrown away, and may not be finite): no warning of numpy's on the way."""
     def run(cap):
         sim, _ = _soft_body()
         sim.check_interval = 40
@@ -269,9 +272,10 @@ def test_bodies_that_share_no_element_collide_through_the_contact_law():
     pa, ra = tdem.pack.regular(0.2, 0.2, 0.01)
     pb, rb = tdem.pack.regular(0.2, 0.2, 0.01, origin=(0.205, 0.0))
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt_fraction=0.3)
-    a = sim.add_particles(pa, ra, material=mat_a, tolerance=0.005, contact=law,
+    # (tolerance 0.9 R: a square lattice's diagonals need 0.828 R to make elements)
+    a = sim.add_particles(pa, ra, material=mat_a, tolerance=0.009, contact=law,
                           velocity=(1.0, 0.0))
-    b = sim.add_particles(pb, rb, material=mat_b, tolerance=0.005, contact=law,
+    b = sim.add_particles(pb, rb, material=mat_b, tolerance=0.009, contact=law,
                           velocity=(-1.0, 0.0))
     p0, scale = _momentum(sim)
     tri = sim.elements.numpy()["triangles"]
@@ -279,7 +283,7 @@ def test_bodies_that_share_no_element_collide_through_the_contact_law():
     tri = sim.elements.numpy()["triangles"]
     ia, ib = set(a.ids.tolist()), set(b.ids.tolist())
     mixed = [t for t in tri if (set(t) & ia) and (set(t) & ib)]
-    assert not mixed
+    assert not mixed and len(tri) >= 2 * 2 * 9 * 9    # each body's 9 × 9 squares cut
     p = sim.particles.numpy()
     xa = p["position"][a.ids, 0].max()
     xb = p["position"][b.ids, 0].min()
