@@ -30,7 +30,7 @@ import taichi as ti
 from tdem.launch import cached
 
 from . import fvm
-from .materials import MAT_G, MAT_K, mc_correct_state
+from .materials import MAT_G, MAT_K, mc_correct_state, mixes
 from .pcmm import viscous_stress
 
 
@@ -70,7 +70,8 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
            mixed: ti.template(), serial: ti.template()):
     """One step of every block triangle (stress and nodal forces), then the element
     forces gathered into ``nforce`` (overwritten). ``mixed``: the nodal mixed
-    discretization (:mod:`physics.fvm`), the volumetric strain increment and the
+    discretization (:mod:`physics.fvm`) for the materials that take it
+    (:func:`physics.materials.mixes`), the volumetric strain increment and the
     in-plane mean stress of the nodal forces averaged through the nodes (not
     ``mixed``: each triangle's own). ``tfor`` holds each triangle's kinematics
     between the passes; ``nmix`` (V, 2) the nodal means."""
@@ -78,7 +79,8 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
     ti.loop_config(serialize=serial)
     for e in range(tri.shape[0]):
         out = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-        if tmat[e] >= 0:            # −1: a triangle of a rigid block (no stress)
+        # −1: a triangle of a rigid block (no stress); area 0: not in the averages
+        if tmat[e] >= 0 and mixes(matp, ti.max(tmat[e], 0)):
             grad, s = _mid_kinematics(tri[e], npos, nvel, dt)
             de = fvm.strain_increment(grad, dt)
             out = ti.Vector([de[0] + de[1], 0.0, 0.0, 0.0, s, 0.0])
@@ -94,9 +96,11 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
             t = tri[e]
             grad, s = _mid_kinematics(t, npos, nvel, dt)
             de = fvm.strain_increment(grad, dt)
-            if ti.static(mixed):
-                de = fvm.mixed_strain(de, (nmix[t[0]][0] + nmix[t[1]][0] + nmix[t[2]][0]) / 3.0)
             M = tmat[e]
+            if ti.static(mixed):
+                if mixes(matp, M):
+                    de = fvm.mixed_strain(de, (nmix[t[0]][0] + nmix[t[1]][0]
+                                               + nmix[t[2]][0]) / 3.0)
             sig = fvm.jaumann_rotate(tsig[e], fvm.spin_rate(grad), dt) + fvm.elastic_increment(
                 de, matp[M, MAT_K], matp[M, MAT_G])
             st = tstate[e]
@@ -120,7 +124,9 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
             r = tfor[e]
             sf = ti.Vector([r[0], r[1], r[2], r[3]])
             if ti.static(mixed):
-                sf = fvm.mixed_stress(sf, (nmix[t[0]][1] + nmix[t[1]][1] + nmix[t[2]][1]) / 3.0)
+                if mixes(matp, tmat[e]):
+                    sf = fvm.mixed_stress(sf, (nmix[t[0]][1] + nmix[t[1]][1]
+                                               + nmix[t[2]][1]) / 3.0)
             fa, fb, fc = fvm.nodal_forces(sf, npos[t[0]], npos[t[1]], npos[t[2]], 1.0)
             tfor[e] = ti.Vector([fa[0], fa[1], fb[0], fb[1], fc[0], fc[1]])
     # 6. gathered per node in a fixed order

@@ -832,6 +832,16 @@ def relax_shear(s, tau, dt):
 
 
 @ti.func
+def mixes(matp: ti.template(), M):
+    """Whether the elements of material row M take the nodal mixed discretization
+    (:mod:`physics.fvm`): Mohr–Coulomb, whose plastic flow at constant volume locks
+    constant-strain triangles. Elastic rows keep their own update (no flow to lock
+    at the Poisson's ratios of rock and soil), and so do fluids and the materials
+    with an equation of state (which carry their pressure per particle)."""
+    return ti.cast(matp[M, MAT_TYPE], ti.i32) == MOHR_COULOMB
+
+
+@ti.func
 def mc_correct_state(s, matp: ti.template(), M, failed):
     """Mohr–Coulomb + tension cut-off correction of a trial stress (module docstring).
 

@@ -977,8 +977,9 @@ class Runner:
                     f"Eq. 1 joins particles with d <= R_i + R_j + tolerance; the diagonals "
                     f"of its lattice need tolerance >= {need:.4g} m ({need / r:.3g} R): raise "
                     f"the tolerance to at least that", RuntimeWarning, stacklevel=5)
-            elif (isinstance(mat, Fluid) and hexagonal > 0.5
+            elif (isinstance(mat, Fluid) and hexagonal > 0.5 and mat.shear_modulus == 0.0
                   and float(np.linalg.norm(self.gravity)) > 0.0):
+                # (a Maxwell fluid, with a shear modulus, holds: tests/test_fluid.py)
                 warnings.warn(
                     f"PCMM body of material Fluid ({len(ids)} particles, {int(made[k])} "
                     f"elements): element water (Fluid without voronoi=True) carries only "

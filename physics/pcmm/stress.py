@@ -16,7 +16,7 @@ from tdem.launch import cached
 from .. import fvm
 from ..materials import (FLUID, JWL_D, JWL_OMEGA, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS,
                          MAT_FLUID_TAU, MAT_G, MAT_K, MAT_RHO, MAT_TYPE, MAT_VISC,
-                         fluid_pressure, jwl_pressure, mc_correct_state, relax_shear)
+                         fluid_pressure, jwl_pressure, mc_correct_state, mixes, relax_shear)
 from .layout import P_NEW, P_RECOUNT, P_SOFT, inc_element
 from .rebuild import SLACK_FLOOR
 from .rules import _cover_incident, _sorted3
@@ -161,7 +161,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     the stress at the same place of ``sigc`` (:func:`copies`).
 
     ``mixed``: the nodal mixed discretization (:mod:`physics.fvm`) for the elements
-    of materials without an equation of state: the volumetric part of each
+    of the materials that take it (:func:`physics.materials.mixes`, Mohr–Coulomb): the volumetric part of each
     element's strain increment is the mean over its three particles of their
     averages Σ V_e Δθ_e / Σ V_e over the elements containing them (V_e = k S_e/N_e,
     the element's share of the area, k its multiplicity), and the in-plane mean
@@ -252,11 +252,12 @@ def _particle_mean(i, k, pmat: ti.template(), matp: ti.template(), inc: ti.templ
                    icnt: ti.template(), eidx: ti.template(), efor: ti.template()):
     """Σ V_e q_e / Σ V_e over the elements containing particle i, q_e in column k of
     their record lines and V_e in column 7 (:func:`stresses`, mixed); 0 for a
-    particle of a material with an equation of state, or in no element."""
+    particle of a material that does not mix (:func:`physics.materials.mixes`), or
+    in no element."""
     out = 0.0
     M = pmat[i]
     if M >= 0:
-        if not _has_eos(matp, M):
+        if mixes(matp, M):
             num = 0.0
             den = 0.0
             for q in range(icnt[i]):
@@ -281,8 +282,7 @@ def _element_stress(a, s, j, jold, cover, theta, pos: ti.template(), vel: ti.tem
     """The stress update of the element in a's slot s (record j; ``jold`` last step's
     record of the slot, ``cover`` its N_e): Eqs. 6–12, into ``sigc[j]``. Not
     ``mixed``: the record follows (:func:`_finish`). ``mixed``: the strain
-    increment's volumetric part is ``theta`` (for a material without an equation of
-    state), and ``efor[j]`` keeps (Δε, N_e, Δe^ps, flag, in-plane mean stress of the
+    increment's volumetric part is ``theta`` (for a material that mixes), and ``efor[j]`` keeps (Δε, N_e, Δe^ps, flag, in-plane mean stress of the
     forces, V_e) for the passes that follow (:func:`stresses`)."""
     b = elem[a, s, 0]
     c = elem[a, s, 1]
@@ -290,7 +290,7 @@ def _element_stress(a, s, j, jold, cover, theta, pos: ti.template(), vel: ti.tem
     M = pmat[a]
     kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
     if ti.static(mixed):
-        if not _has_eos(matp, M):
+        if mixes(matp, M):
             de = fvm.mixed_strain(de, theta)
     sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
     eps = 0.0
@@ -365,7 +365,8 @@ def _finish(a, s, j, b, c, M, sig, eps, flag, de, area, cover, matp: ti.template
     if not _has_eos(matp, M):
         sf = _force_stress(matp, M, sig, de, dt, area)
         if ti.static(mixed):
-            sf = fvm.mixed_stress(sf, mean)
+            if mixes(matp, M):
+                sf = fvm.mixed_stress(sf, mean)
         wf = 1.0 / cover
     _record(efor, j, sig, sf, wf, de, eps, flag, emult[a, s], b, c)
 
