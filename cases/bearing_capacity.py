@@ -1,0 +1,348 @@
+"""Bearing capacity of a smooth rigid strip footing on weightless soil: Prandtl's collapse load.
+
+The collapse of many elements flowing plastically together, checked against limit
+analysis: a smooth rigid strip footing of width B = 2b pushed slowly into a
+weightless Mohr–Coulomb soil reaches q = N_c·c, with Prandtl's (1920)
+
+    N_c = 2 + π = 5.14 (φ = 0, Tresca),
+    N_c = (N_q − 1)·cot φ,  N_q = e^{π tan φ}·tan²(45° + φ/2)  (= 14.83 at φ = 20°),
+
+exact for a rigid–perfectly plastic soil with an associated flow rule. Each model is
+run at three resolutions (cells, or particle spacings, under the half-footing) on
+the PCMM regular, cross and random packings and on FVM block meshes, so that the
+table shows the limit load converging towards N_c from above.
+
+Set-up (the half of the problem right of the footing's centre line, x ≥ 0)
+--------------------------------------------------------------------------
+- Soil: ``tdem.MohrCoulomb``, c = 10 kPa, E = 10 MPa, ν = 0.3, ρ = 2000 kg/m³ (only
+  the inertia of the slow push; no gravity). φ = 0: Tresca with tension allowed
+  (T = 1 GPa, so that no cut-off acts: Prandtl's solution has none); φ = 20°:
+  dilation ψ = φ (the associated flow Prandtl's N_c assumes) and the apex
+  c/tan φ as tension cut-off. E/c = 1000 puts the elastic settlement at the limit
+  load near 1 % of b: the curve reaches its plateau well inside the run.
+- Domain: b = 0.5 m; φ = 0: 4b × 2b (Prandtl's mechanism reaches 3b from the
+  centre line and b·sqrt(2) deep); φ = 20°: 8b × 3b (its log spiral reaches about
+  6b). Bottom fixed; the centre line x = 0 (symmetry) and the far side on vertical
+  rollers (vx = 0).
+- Footing: a rigid block (every node driven: a kinematic tool) whose bottom edge
+  spans x = −2h to b, touching the soil's surface, pushed down at v = 0.01 m/s
+  (v/c_p ≈ 1e-4: quasi-static), coupled to the soil by point–edge contacts
+  without friction (``tdem.PointEdge(friction_angle=0)``): PCMM particles against
+  its edges, an FVM block's surface vertices against its bottom edge and its
+  corner vertex against the soil's surface edges. The footing's edge x = b lies
+  half-way between two surface particles (nodes), so that the particles under it
+  have tributary widths adding up to b.
+- Local damping 0.7 (quasi-static; the unbalanced forces of a steady push are small).
+- Read-out: q = (vertical force on the footing)/b against the settlement s (the
+  footing's travel) up to s = 0.1 b. The limit load is the mean q over
+  s/b ∈ [0.08, 0.10]; the curve is flat there when q changes by less than 3 % of it
+  between s/b = 0.07 and 0.10.
+
+Discretisation
+--------------
+Constant-strain triangles lock in isochoric flow: every element must keep its area
+while it flows plastically at constant volume, which a mesh of triangles cannot do
+(it has about one volumetric constraint per degree of freedom), and the PCMM
+element system, which superposes both diagonals of each square, has two. tdem's
+elements therefore use the nodal mixed discretization (docs/pcmm.md): the volumetric
+strain increment of each element is the mean over its three nodes (particles) of
+their area-weighted averages, and the mean stress of its nodal forces likewise,
+so that there is one volumetric constraint per node. The table in docs/pcmm.md
+compares it with the plain element update.
+
+Checks
+------
+- ``<model>.<n>.limit`` (φ = 0): N_c = 2 + π within 5 % at the finest resolution of
+  each model, reported at the coarser ones;
+- ``<model>.converging``: the limit loads fall (or stay within 1 %) from the
+  coarsest to the finest resolution and stay above 0.97 N_c;
+- ``<model>.<n>.flat``: the curve's rise between s/b = 0.07 and 0.10 below 3 %;
+- ``phi20.<model>.limit``: N_c = 14.83 within 10 %.
+
+Presets: ``quick``: resolutions 4, 6 and 10 (cells or spacings under the
+half-footing) for FVM regular and PCMM regular, and φ = 20° on the FVM regular
+mesh at 6; ``paper``: 5, 10 and 20 for every model (FVM regular and cross, PCMM
+regular, cross and random) and φ = 20° on FVM and PCMM regular at 10.
+
+Outputs (``--out DIR``, default out/bearing_capacity): ``load_settlement.png``
+(q/c against s/b, every model and resolution, with N_c), ``convergence.png``
+(limit load against resolution), ``mechanism.png`` (the plastic strain of the
+finest run of each model), ``histories.h5``, ``summary.json``.
+"""
+import math
+import time
+
+import numpy as np
+
+import tdem
+
+from . import _common as common
+from . import _pcmm
+
+CASE = "bearing_capacity"
+B_HALF = 0.5
+COHESION, YOUNG, POISSON, RHO = 10e3, 10e6, 0.3, 2000.0
+SPEED = 0.01
+S_END = 0.10                  # settlement / b at the end of a run
+WINDOW = (0.08, 0.10)         # the limit load: mean q over this range of s/b
+FLAT_FROM = 0.07              # flat: q(0.10) − q(0.07) below FLAT_TOL of q
+FLAT_TOL, LIMIT_TOL, PHI20_TOL, FLOOR = 0.03, 0.05, 0.10, 0.97
+SAMPLES = 40                  # points of the load–settlement curve
+
+PRESETS = {
+    "quick": {"models": ("fvm", "regular"), "resolutions": (4, 6, 10),
+              "phi20": (("fvm", 6),)},
+    "paper": {"models": ("fvm", "fvm_cross", "regular", "cross", "random"),
+              "resolutions": (5, 10, 20), "phi20": (("fvm", 10), ("regular", 10))},
+}
+
+
+def prandtl(phi_deg):
+    """Prandtl's N_c for the friction angle φ (degrees): 2 + π at φ = 0,
+    (N_q − 1)·cot φ with N_q = e^{π tan φ}·tan²(45° + φ/2) above."""
+    if phi_deg == 0:
+        return 2.0 + math.pi
+    t = math.tan(math.radians(phi_deg))
+    nq = math.exp(math.pi * t) * math.tan(math.radians(45.0 + 0.5 * phi_deg)) ** 2
+    return (nq - 1.0) / t
+
+
+def soil(phi_deg):
+    """The soil's material (module docstring)."""
+    if phi_deg == 0:
+        return tdem.MohrCoulomb(density=RHO, young=YOUNG, poisson=POISSON, cohesion=COHESION,
+                                friction_angle=0.0, tensile_strength=1e9)
+    return tdem.MohrCoulomb(density=RHO, young=YOUNG, poisson=POISSON, cohesion=COHESION,
+                            friction_angle=phi_deg, dilation_angle=phi_deg)
+
+
+def domain(phi_deg):
+    """(W, H) of the half-model."""
+    return (4.0 * B_HALF, 2.0 * B_HALF) if phi_deg == 0 else (8.0 * B_HALF, 3.0 * B_HALF)
+
+
+def spec(kind, n, W, H):
+    """The model spec (cases._pcmm) of ``kind`` with n cells or spacings under the
+    half-footing (h = b/n)."""
+    h = B_HALF / n
+    if kind in ("fvm", "fvm_cross"):
+        return {"kind": "fvm", "cells": (int(round(W / h)), int(round(H / h))),
+                "pattern": "cross" if kind == "fvm_cross" else "regular"}
+    if kind == "regular":
+        return {"kind": "regular", "radius": 0.5 * h, "tolerance": 0.5 * h, "inset": 0}
+    if kind == "cross":
+        return {"kind": "cross", "radius": 0.5 * h, "tolerance": 0.5 * h, "inset": 0,
+                "fit": True}
+    if kind == "random":
+        # radii 0.6–1.4 of the lattices' (the same mean spacing), denser than jamming
+        # with the holes of the element cover filled, as the other PCMM cases
+        return {"kind": "random", "rmin": 0.3 * h, "rmax": 0.7 * h, "tolerance": 0.5 * h,
+                "fraction": 0.86, "overlap_tol": 0.7, "fill_holes": True,
+                "edge_centres": True}
+    raise ValueError(f"kind {kind!r}: choose fvm, fvm_cross, regular, cross or random")
+
+
+def footing(kind, n, phi_deg=0.0, speed=SPEED, s_end=S_END, sim_kwargs=None, mixed=True,
+            progress=False):
+    """Build and run one footing; returns a dict with the model, the load–settlement
+    curve (``s_over_b``, ``q_over_c``), the limit load and the flatness.
+    ``mixed=False`` runs the elements' plain update (for comparison)."""
+    W, H = domain(phi_deg)
+    kw = dict(gravity=(0.0, 0.0), local_damping=0.7, progress=progress,
+              mixed_discretization=mixed)
+    kw.update(sim_kwargs or {})
+    name = f"{kind}" if kind != "fvm_cross" else "fvm_cross"
+    m = _pcmm.Model(name, spec(kind, n, W, H), W, H, soil(phi_deg), kw)
+    sim = m.sim
+    x = m.x0
+    tol = 1e-6 * W
+    bottom = np.flatnonzero(x[:, 1] < x[:, 1].min() + tol)
+    if m.is_fvm:
+        left = np.flatnonzero(x[:, 0] < tol)
+        right = np.flatnonzero(x[:, 0] > W - tol)
+    else:
+        left, right = m.edge("left"), m.edge("right")
+    m.fix(bottom, vx=0.0, vy=0.0)
+    m.fix(np.setdiff1d(left, bottom), vx=0.0, vy=None)
+    m.fix(np.setdiff1d(right, bottom), vx=0.0, vy=None)
+    # the footing: its edge half-way between two surface points
+    if m.is_fvm:
+        top = x[:, 1].max()
+        surf = np.sort(x[x[:, 1] > top - tol, 0])
+        y0 = top
+    else:
+        r = m.r
+        top = float((x[:, 1] + r).max())
+        near = x[:, 1] + r > top - 0.5 * float(r.max())
+        surf = np.sort(x[near, 0])
+        y0 = top
+    below = surf[surf <= B_HALF]
+    above = surf[surf > B_HALF]
+    b = 0.5 * (below.max() + above.min())
+    h = B_HALF / n
+    fv = np.array([[-2.0 * h, y0], [b, y0], [b, y0 + 0.4 * B_HALF], [-2.0 * h, y0 + 0.4 * B_HALF]])
+    ft = np.array([[0, 1, 2], [0, 2, 3]])
+    # the point–edge springs take the stiffer side's E (tdem.PointEdge): the soil's for
+    # particles (a spring of E over 2R moves the footing 1 % of b at the limit load);
+    # 10 E for an FVM block's vertices, which must stay within 5 % of their tributary
+    # length of the footing's edge (coupling.point_edge)
+    tool = sim.add_block(fv, ft, tdem.Elastic(density=RHO, young=(10.0 if m.is_fvm else 1.0)
+                                              * YOUNG, poisson=0.2), rigid=True)
+    tool.fix(np.arange(4), vx=0.0, vy=-speed)
+    law = tdem.PointEdge(friction_angle=0.0)
+    # (two blocks: vertex–edge contacts both ways)
+    sim.couple(m.block if m.is_fvm else m.group, tool, law)
+    t_end = s_end * b / speed
+    times = np.linspace(0.0, t_end, SAMPLES + 1)[1:]
+    s_b, q_c = [0.0], [0.0]
+    watch = time.perf_counter()
+    for t in times:
+        sim.run(until=t)
+        nd = tool.nodes()
+        s_b.append(float(-nd["displacement"][:, 1].mean()) / b)
+        q_c.append(float(-nd["reaction"][:, 1].sum()) / b / COHESION)
+    s_b, q_c = np.array(s_b), np.array(q_c)
+    sel = (s_b >= WINDOW[0] * s_end / S_END) & (s_b <= WINDOW[1] * s_end / S_END + 1e-9)
+    limit = float(q_c[sel].mean())
+    q07 = float(np.interp(FLAT_FROM * s_end / S_END, s_b, q_c))
+    rise = (q_c[-1] - q07) / q_c[-1]
+    return {"model": m, "tool": tool, "b": b, "h": h, "n": n, "kind": kind, "phi": phi_deg,
+            "s_over_b": s_b, "q_over_c": q_c, "limit": limit, "rise": float(rise),
+            "steps": sim.steps, "dt": sim.dt, "run_s": time.perf_counter() - watch,
+            "count": m.count}
+
+
+def run(preset="quick", out=None, models=None, arch=None, threads=None):
+    """Run the case; returns the summary dict (also written to out/summary.json)."""
+    out = common.output_dir(CASE, out)
+    watch = common.Stopwatch()
+    p = PRESETS[preset]
+    kinds = list(p["models"] if models is None else models)
+    sk = dict(arch=arch, threads=threads)
+    nc0, nc20 = prandtl(0.0), prandtl(20.0)
+    runs, checks, data, hist = [], [], {"N_c": {"0": nc0, "20": nc20}, "runs": {}}, {}
+    for kind in kinds:
+        mine = []
+        for n in p["resolutions"]:
+            r = footing(kind, n, 0.0, sim_kwargs=sk)
+            mine.append(r)
+            runs.append(r)
+            print(f"  {kind} n = {n}: q/c = {r['limit']:.3f} (N_c {nc0:.3f}), rise "
+                  f"{100 * r['rise']:.1f} %, {r['steps']} steps, {r['run_s']:.0f} s", flush=True)
+        finest = mine[-1]["n"]
+        for r in mine:
+            label = f"{_pcmm.LABELS.get(kind, kind)}, {r['n']} per half-width"
+            tol = common.rel(LIMIT_TOL) if r["n"] == finest else None
+            checks.append(common.check(f"{kind}.{r['n']}.limit", r["limit"], nc0, tol, "q/c",
+                                       f"{label}: mean q/c over s/b 0.08–0.10; target 2 + π"))
+            checks.append(common.check(f"{kind}.{r['n']}.flat", r["rise"], None,
+                                       common.between(max=FLAT_TOL), "",
+                                       f"{label}: (q(0.10 b) − q(0.07 b))/q"))
+        lims = [r["limit"] for r in mine]
+        falls = all(lims[k + 1] <= lims[k] * 1.01 for k in range(len(lims) - 1))
+        conv = float(falls and min(lims) >= FLOOR * nc0)
+        checks.append(common.check(f"{kind}.converging", conv, 1.0, common.EQUAL, "",
+                                   f"{_pcmm.LABELS.get(kind, kind)}: limit loads "
+                                   f"{', '.join(f'{v:.3f}' for v in lims)} fall with the "
+                                   f"resolution (1 % slack) and stay above {FLOOR} N_c"))
+    for kind, n in p["phi20"]:
+        if kind not in kinds:
+            continue
+        r = footing(kind, n, 20.0, sim_kwargs=sk)
+        runs.append(r)
+        print(f"  phi = 20, {kind} n = {n}: q/c = {r['limit']:.3f} (N_c {nc20:.3f})", flush=True)
+        checks.append(common.check(f"phi20.{kind}.limit", r["limit"], nc20,
+                                   common.rel(PHI20_TOL), "q/c",
+                                   f"{_pcmm.LABELS.get(kind, kind)}, {n} per half-width, "
+                                   "φ = ψ = 20°: mean q/c over s/b 0.08–0.10; target "
+                                   "(N_q − 1) cot φ"))
+    for r in runs:
+        key = f"phi{int(r['phi'])}.{r['kind']}.{r['n']}"
+        data["runs"][key] = {"limit": r["limit"], "rise": r["rise"], "b": r["b"], "h": r["h"],
+                             "steps": r["steps"], "dt": r["dt"], "run_s": r["run_s"],
+                             "count": r["count"]}
+        hist[key] = {"s_over_b": r["s_over_b"], "q_over_c": r["q_over_c"]}
+    return _pcmm.finish(CASE, preset, checks, data, out, hist,
+                        lambda: plots(runs, out, nc0, nc20), watch, threads=threads,
+                        paper="Prandtl (1920); limit analysis of a smooth strip footing")
+
+
+def plots(runs, out, nc0, nc20):
+    plt = common.pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), squeeze=False)
+    for ax, phi, nc in ((axes[0, 0], 0.0, nc0), (axes[0, 1], 20.0, nc20)):
+        mine = [r for r in runs if r["phi"] == phi]
+        for r in mine:
+            ns = sorted({q["n"] for q in mine if q["kind"] == r["kind"]})
+            alpha = 0.35 + 0.65 * (ns.index(r["n"]) + 1) / len(ns)
+            ax.plot(r["s_over_b"], r["q_over_c"], color=_pcmm.COLORS.get(r["kind"], "k"),
+                    alpha=alpha, lw=1.2,
+                    label=f"{_pcmm.LABELS.get(r['kind'], r['kind'])}, b/h = {r['n']}")
+        ax.axhline(nc, color="k", ls="--", lw=1, label=f"Prandtl N_c = {nc:.2f}")
+        ax.set_xlabel("settlement s / b")
+        ax.set_ylabel("q / c")
+        ax.set_title(f"φ = {phi:.0f}°", fontsize=10)
+        ax.set_ylim(0, 1.3 * nc)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
+    fig.suptitle("Smooth strip footing on weightless soil: load–settlement", fontsize=10)
+    fig.tight_layout()
+    common.save(fig, out / "load_settlement.png")
+
+    fig, ax = plt.subplots(figsize=(5.5, 4))
+    kinds = []
+    for r in runs:
+        if r["phi"] == 0 and r["kind"] not in kinds:
+            kinds.append(r["kind"])
+    for k in kinds:
+        mine = [r for r in runs if r["phi"] == 0 and r["kind"] == k]
+        ax.plot([r["n"] for r in mine], [r["limit"] for r in mine],
+                marker=_pcmm.MARKERS.get(k, "o"), mfc="none", color=_pcmm.COLORS.get(k, "k"),
+                label=_pcmm.LABELS.get(k, k))
+    ax.axhline(nc0, color="k", ls="--", lw=1, label="2 + π")
+    ax.axhspan(nc0, nc0 * (1 + LIMIT_TOL), color="0.85", label="within 5 %")
+    ax.set_xscale("log")
+    ax.set_xlabel("cells (particle spacings) under the half-footing, b/h")
+    ax.set_ylabel("limit load q / c")
+    ax.set_title("Tresca soil: limit load against resolution", fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    common.save(fig, out / "convergence.png")
+
+    finest = {}
+    for r in runs:
+        if r["phi"] == 0 and (r["kind"] not in finest or r["n"] > finest[r["kind"]]["n"]):
+            finest[r["kind"]] = r
+    if not finest:
+        return
+    fig, axes = plt.subplots(1, len(finest), figsize=(3.6 * len(finest), 2.6), squeeze=False)
+    for ax, r in zip(axes[0], finest.values()):
+        m = r["model"]
+        if m.is_fvm:
+            nd = m.block.nodes()
+            el = m.block.elements()
+            xy = np.asarray(nd["position"])
+            tri = np.asarray(el["triangles"])
+            pc = ax.tripcolor(xy[:, 0], xy[:, 1], tri, facecolors=np.asarray(el["plastic_strain"]),
+                              cmap="magma_r", vmin=0.0, vmax=0.05)
+        else:
+            p = m.sim.particles.numpy()
+            xy = np.asarray(p["position"])
+            pc = ax.scatter(xy[:, 0], xy[:, 1], c=np.asarray(p["plastic_strain"]), s=4,
+                            cmap="magma_r", vmin=0.0, vmax=0.05)
+        ax.axvline(r["b"], color="C0", lw=0.8, ls=":")
+        ax.set_aspect("equal")
+        ax.set_title(f"{_pcmm.LABELS.get(r['kind'], r['kind'])}, b/h = {r['n']}", fontsize=9)
+        ax.tick_params(labelsize=7)
+    fig.colorbar(pc, ax=list(axes[0]), shrink=0.8, label="plastic shear strain")
+    fig.suptitle("Plastic strain at s = 0.1 b (Prandtl's mechanism)", fontsize=10)
+    common.save(fig, out / "mechanism.png")
+
+
+def main(argv=None):
+    return _pcmm.main(CASE, run, __doc__, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
