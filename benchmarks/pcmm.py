@@ -42,7 +42,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 PACKINGS = ("regular", "cross", "random", "dense")
 
 
-def build(side=200, arch=None, threads=None, packing="regular"):
+def build(side=200, arch=None, threads=None, packing="regular", mixed=True):
     import tdem
     r = 0.01
     w = 2 * r * side
@@ -61,7 +61,8 @@ def build(side=200, arch=None, threads=None, packing="regular"):
                             friction_angle=30.0, tensile_strength=500.0, brittle=True)
     law = tdem.LinearContact(kn=10e6, ks=10e6, friction=0.5)
     sim = tdem.Simulation(gravity=(0.0, -9.81), dt_fraction=0.4, arch=arch, threads=threads,
-                          check_interval=500, progress=False, local_damping=0.05)
+                          check_interval=500, progress=False, local_damping=0.05,
+                          mixed_discretization=mixed)
     sim.add_particles(pos, rad, material=soil, tolerance=r, contact=law)
     sim.add_wall((-10.0, 0.0), (12.0, 0.0), contact=law)
     return sim
@@ -77,12 +78,13 @@ def _timed(sim, steps):
     return time.perf_counter() - t
 
 
-def measure(side, steps, warmup, arch, threads, rounds=5, dem=True, packing="regular"):
+def measure(side, steps, warmup, arch, threads, rounds=5, dem=True, packing="regular",
+            mixed=True):
     """Rates (particle-steps/s) of the PCMM column and, if ``dem``, of the DEM pack,
     timed in ``rounds`` alternating rounds after their warm-ups: (PCMM info, list of
     PCMM rates, list of DEM rates, DEM particle count)."""
     from benchmarks.pack2d import build as build_dem
-    sim = build(side, arch, threads, packing)
+    sim = build(side, arch, threads, packing, mixed)
     sim.run(steps=warmup)
     pack = None
     if dem:
@@ -143,12 +145,14 @@ def main(argv=None):
                    help="alternating timed rounds of the PCMM column and the DEM pack")
     p.add_argument("--arch", default=None)
     p.add_argument("--no-dem", action="store_true", help="skip the DEM pack reference")
+    p.add_argument("--no-mixed", action="store_true",
+                   help="Simulation(mixed_discretization=False): the elements' own update")
     args = p.parse_args(argv)
     if args.rounds < 1:
         p.error(f"--rounds must be >= 1, got {args.rounds}")
     r, rates, dem_rates, n_dem = measure(args.side, args.steps, args.warmup, args.arch,
                                          args.threads, args.rounds, not args.no_dem,
-                                         args.packing)
+                                         args.packing, not args.no_mixed)
     rate = float(np.median(rates))
     print(f"machine: {machine()}")
     print(f"PCMM {args.packing} particles {r['particles']} steps {r['steps']} in {args.rounds} rounds "
