@@ -41,7 +41,8 @@ from cases import _common as common
 ROOT = Path(__file__).resolve().parents[1]
 #: the order of the tables: the papers' order (docs/cases.md)
 ORDER = ("nine_disc", "photoelastic", "biaxial", "elastic_gravity", "uniaxial_compression",
-         "wave_bar", "soil_cutting", "contact_burst", "water_blocks", "plate_loading",
+         "wave_bar", "bearing_capacity", "soil_cutting", "contact_burst", "water_blocks",
+         "plate_loading",
          "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break")
 #: a few words on each case for the overview table
 WHAT = {
@@ -49,6 +50,7 @@ WHAT = {
     "photoelastic": "197 discs in a box: force picture, wall forces (Cundall & Strack)",
     "biaxial": "biaxial tests with rolling resistance (Jiang et al.)",
     "elastic_gravity": "rock under gravity, PCMM against FVM (Feng et al.)",
+    "bearing_capacity": "a rigid strip footing pushed into soil: Prandtl's collapse load",
     "uniaxial_compression": "a rock sample compressed to failure (Feng et al.)",
     "wave_bar": "a velocity pulse along a 20 m bar (Feng et al.)",
     "soil_cutting": "a blade cutting Mohr–Coulomb soil (Feng et al.)",
