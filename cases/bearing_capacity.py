@@ -24,14 +24,16 @@ Set-up (the half of the problem right of the footing's centre line, x ≥ 0)
   centre line and b·sqrt(2) deep); φ = 20°: 8b × 3b (its log spiral reaches about
   6b). Bottom fixed; the centre line x = 0 (symmetry) and the far side on vertical
   rollers (vx = 0).
-- Footing: a rigid block (every node driven: a kinematic tool) whose bottom edge
-  spans x = −2h to b, touching the soil's surface, pushed down at v = 0.01 m/s
-  (v/c_p ≈ 1e-4: quasi-static), coupled to the soil by point–edge contacts
-  without friction (``tdem.PointEdge(friction_angle=0)``): PCMM particles against
-  its edges, an FVM block's surface vertices against its bottom edge and its
-  corner vertex against the soil's surface edges. The footing's edge x = b lies
-  half-way between two surface particles (nodes), so that the particles under it
-  have tributary widths adding up to b.
+- Footing, pushed down at v = 0.01 m/s (v/c_p ≈ 1e-4: quasi-static): on PCMM
+  soil a rigid block (every node driven: a kinematic tool) whose bottom edge spans
+  x = −2h to b, touching the soil's surface, coupled to the particles by
+  point–edge contacts without friction (``tdem.PointEdge(friction_angle=0)``),
+  its edge x = b half-way between two surface particles, so that the particles
+  under it have tributary widths adding up to b; on an FVM mesh the surface nodes
+  at x ≤ b/(1 + 1/2n) driven down, their horizontal motion free, and b half-way to
+  the next node (vertex–edge springs stiff enough to hold the mesh's surface
+  vertices would cut the step tenfold, and the vertices beside the block's corner
+  slipped off its edge, taking load away).
 - Local damping 0.7 (quasi-static; the unbalanced forces of a steady push are small).
 - Read-out: q = (vertical force on the footing)/b against the settlement s (the
   footing's travel) up to s = 0.1 b. The limit load is the mean q over
@@ -165,42 +167,49 @@ def footing(kind, n, phi_deg=0.0, speed=SPEED, s_end=S_END, sim_kwargs=None, mix
     m.fix(bottom, vx=0.0, vy=0.0)
     m.fix(np.setdiff1d(left, bottom), vx=0.0, vy=None)
     m.fix(np.setdiff1d(right, bottom), vx=0.0, vy=None)
-    # the footing: its edge half-way between two surface points
+    h = B_HALF / n
     if m.is_fvm:
+        # the rigid smooth footing is the surface nodes under it, driven down with
+        # their horizontal motion free (the vertex–edge springs of a footing block
+        # would limit the step tenfold, and surface vertices beside its corner slip
+        # off its edge); its width runs to half-way to the next node, as below
         top = x[:, 1].max()
+        driven = np.flatnonzero((x[:, 1] > top - tol) & (x[:, 0] <= B_HALF + tol))
         surf = np.sort(x[x[:, 1] > top - tol, 0])
-        y0 = top
+        m.block.fix(driven, vx=None, vy=-speed)
+        tool = None
     else:
+        # a rigid block touching the surface, its edge half-way between two surface
+        # particles, coupled by frictionless point–edge contacts; the springs take
+        # the stiffer side's E (tdem.PointEdge), here the soil's: a spring of E over
+        # 2R moves the footing by 1 % of b at the limit load
         r = m.r
         top = float((x[:, 1] + r).max())
-        near = x[:, 1] + r > top - 0.5 * float(r.max())
-        surf = np.sort(x[near, 0])
-        y0 = top
-    below = surf[surf <= B_HALF]
-    above = surf[surf > B_HALF]
+        surf = np.sort(x[x[:, 1] + r > top - 0.5 * float(r.max()), 0])
+    below = surf[surf <= B_HALF + tol]
+    above = surf[surf > B_HALF + tol]
     b = 0.5 * (below.max() + above.min())
-    h = B_HALF / n
-    fv = np.array([[-2.0 * h, y0], [b, y0], [b, y0 + 0.4 * B_HALF], [-2.0 * h, y0 + 0.4 * B_HALF]])
-    ft = np.array([[0, 1, 2], [0, 2, 3]])
-    # the point–edge springs take the stiffer side's E (tdem.PointEdge): the soil's for
-    # particles (a spring of E over 2R moves the footing 1 % of b at the limit load);
-    # 10 E for an FVM block's vertices, which must stay within 5 % of their tributary
-    # length of the footing's edge (coupling.point_edge)
-    tool = sim.add_block(fv, ft, tdem.Elastic(density=RHO, young=(10.0 if m.is_fvm else 1.0)
-                                              * YOUNG, poisson=0.2), rigid=True)
-    tool.fix(np.arange(4), vx=0.0, vy=-speed)
-    law = tdem.PointEdge(friction_angle=0.0)
-    # (two blocks: vertex–edge contacts both ways)
-    sim.couple(m.block if m.is_fvm else m.group, tool, law)
+    if not m.is_fvm:
+        fv = np.array([[-2.0 * h, top], [b, top], [b, top + 0.4 * B_HALF],
+                       [-2.0 * h, top + 0.4 * B_HALF]])
+        tool = sim.add_block(fv, np.array([[0, 1, 2], [0, 2, 3]]),
+                             tdem.Elastic(density=RHO, young=YOUNG, poisson=0.2), rigid=True)
+        tool.fix(np.arange(4), vx=0.0, vy=-speed)
+        sim.couple(m.group, tool, tdem.PointEdge(friction_angle=0.0))
     t_end = s_end * b / speed
     times = np.linspace(0.0, t_end, SAMPLES + 1)[1:]
     s_b, q_c = [0.0], [0.0]
     watch = time.perf_counter()
     for t in times:
         sim.run(until=t)
-        nd = tool.nodes()
-        s_b.append(float(-nd["displacement"][:, 1].mean()) / b)
-        q_c.append(float(-nd["reaction"][:, 1].sum()) / b / COHESION)
+        if m.is_fvm:
+            nd = m.block.nodes()
+            disp, react = nd["displacement"][driven], nd["reaction"][driven]
+        else:
+            nd = tool.nodes()
+            disp, react = nd["displacement"], nd["reaction"]
+        s_b.append(float(-disp[:, 1].mean()) / b)
+        q_c.append(float(-react[:, 1].sum()) / b / COHESION)
     s_b, q_c = np.array(s_b), np.array(q_c)
     sel = (s_b >= WINDOW[0] * s_end / S_END) & (s_b <= WINDOW[1] * s_end / S_END + 1e-9)
     limit = float(q_c[sel].mean())
