@@ -604,15 +604,39 @@ def sweep_table(rows):
     return "\n".join(lines) + "\n"
 
 
+def _sweep_member(out, **task):
+    """One member of the sweep's ensemble: :func:`sweep_task` writing under ``out``."""
+    return sweep_task(task, out)
+
+
 def run_sweep(tasks, out, workers=2, scheduler=None):
-    """Run ``tasks`` on Dask (a ``distributed.LocalCluster`` of ``workers`` processes
-    with one thread each, or the cluster at ``scheduler``), printing each run as it
-    ends; returns the rows in task order."""
-    with common.dask_client(scheduler, workers) as client:
-        futures = [client.submit(sweep_task, t, str(out), pure=False) for t in tasks]
-        return common.gather_in_order(futures, "water_blocks sweep", lambda r: (
-            f"{task_name(r)}: {r['outcome']} (dx {r['top_dx_max_m']:.3f} "
-            f"m, rotation {r['top_rotation_max_deg']:.1f}°, {r['wall_s'] / 60:.1f} min)"))
+    """Run ``tasks`` with :func:`tdem.ensemble` (a ``distributed.LocalCluster`` of
+    ``workers`` processes with one thread each, or the cluster at ``scheduler``),
+    printing each run as it ends; returns the rows in task order. Each run is kept
+    in ``out/sweep`` as it ends (its table there too), and a sweep started again
+    with the same ``out`` runs only the runs not done. A run that raises is a row
+    with ``status`` "error" and its traceback in ``error``; the others go on."""
+    import functools
+
+    import tdem
+    common.dask_distributed()          # no Dask: say how to install it, before anything
+    count = [0]
+
+    def line(r):
+        count[0] += 1
+        if r["status"] != "ok":
+            text = r["error"].strip().splitlines()
+            common.say(f"water_blocks sweep: {count[0]}/{len(tasks)} {task_name(r)}: error "
+                       f"({text[-1] if text else ''})")
+            return
+        common.say(f"water_blocks sweep: {count[0]}/{len(tasks)} {task_name(r)}: "
+                   f"{r['outcome']} (dx {r['top_dx_max_m']:.3f} m, rotation "
+                   f"{r['top_rotation_max_deg']:.1f}°, {r['wall_s'] / 60:.1f} min)")
+
+    res = tdem.ensemble(functools.partial(_sweep_member, str(out)), tasks,
+                        client=scheduler, workers=None if scheduler else workers,
+                        threads=1, out=Path(out) / "sweep", progress=False, on_result=line)
+    return res.rows
 
 
 def plot_sweep(rows, png):
@@ -685,11 +709,17 @@ def main_sweep(args, out):
     rows = run_sweep(tasks, out, workers=args.workers, scheduler=args.scheduler)
     (out / "sweep.json").write_text(json.dumps(
         [{k: v for k, v in r.items() if k not in ("t", "dx_top")} for r in rows], indent=1))
-    table = sweep_table(rows)
+    ok = [r for r in rows if r["status"] == "ok"]
+    table = sweep_table(ok)
     (out / "sweep.md").write_text(table)
-    plot_sweep(rows, out / "sweep.png")
+    if ok:
+        plot_sweep(ok, out / "sweep.png")
     print(table)
     print(f"sweep: {out / 'sweep.md'}, {out / 'sweep.png'}")
+    if len(ok) < len(rows):
+        print(f"water_blocks sweep: {len(rows) - len(ok)} of {len(rows)} runs failed "
+              f"(their tracebacks: {out / 'sweep' / 'results.csv'})", file=sys.stderr)
+        return 1
     return 0
 
 

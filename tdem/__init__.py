@@ -6,7 +6,8 @@ The public API (see docs/api.md): :class:`Simulation`, the contact laws
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
 :class:`InputError`, :class:`InstabilityError`; :func:`plot_history` plots monitor
-histories.
+histories; :func:`ensemble` runs a function over many parameter sets on a Dask
+cluster (``tdem.ensemble.grid`` makes a grid of them).
 """
 from coupling.point_edge import PointEdge
 from physics.contact_law import ContactLaw, register_law
@@ -23,6 +24,10 @@ from .plot import plot_history
 from .errors import CapacityError, InputError, InstabilityError
 from .pack import random_orientations
 from .simulation import Block, Mesh, ParticleGroup, Simulation, Wall
+from .ensemble import Results as _EnsembleResults, ensemble, grid as _grid
+
+ensemble.grid = _grid                  # tdem.ensemble.grid(a=[...], b=[...])
+ensemble.Results = _EnsembleResults
 
 __version__ = "0.1.0"
 
@@ -30,4 +35,5 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "random_orientations", "ContactLaw", "register_law",
            "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
-           "InstabilityError", "CapacityError", "mesh", "pack", "plot_history"]
+           "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
+           "ensemble"]
