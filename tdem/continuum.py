@@ -26,7 +26,7 @@ from coupling import point_edge as pe
 from physics import blocks as blk
 from physics import pcmm
 from physics.materials import (JWL, JWL_TYPE, MAT_G, MAT_K, MAT_RHO, MAT_TYPE, MAT_WIDTH,
-                               Fluid)
+                               Fluid, MohrCoulomb)
 from physics.pcmm import cells as vcells
 
 from . import backend
@@ -205,7 +205,9 @@ class Continuum:
         self._setup_couples(couples)
         self.nr = {}
         self.carry_stress = True
-        self.mixed = bool(mixed)     # the nodal mixed discretization (physics.fvm)
+        # the nodal mixed discretization (physics.fvm), compiled in where a material
+        # takes it (physics.materials.mixes: Mohr–Coulomb)
+        self.mixed = bool(mixed) and any(isinstance(m, MohrCoulomb) for m, _ in slots)
         self.snap = {}
 
     # ------------------------------------------------------------------ set-up

@@ -204,8 +204,9 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     ebud[a, s] -= uw
                 if ti.static(mixed):
                     grad, de, area = _kinematics(a, b, c, pos, vel, dt)
-                    efor[j] = ti.Vector([de[0] + de[1], ti.cast(jold, ti.f64), 0.0,
-                                         ti.cast(cover, ti.f64), 0.0, 0.0, 0.0,
+                    efor[j] = ti.Vector([de[0], de[1], de[2], fvm.spin_rate(grad),
+                                         ti.cast(jold, ti.f64), ti.cast(cover, ti.f64),
+                                         de[0] + de[1],
                                          ti.cast(emult[a, s], ti.f64) * area / cover])
                 else:
                     _element_stress(a, s, j, jold, cover, 0.0, pos, vel, pmat, matp, elem,
@@ -216,7 +217,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
     if ti.static(mixed):
         ti.loop_config(serialize=serial)
         for i in range(pmat.shape[0]):
-            pmix[i] = ti.Vector([_particle_mean(i, 0, pmat, matp, inc, icnt, eidx, efor), 0.0])
+            pmix[i] = ti.Vector([_particle_mean(i, 6, pmat, matp, inc, icnt, eidx, efor), 0.0])
         ti.loop_config(serialize=serial)
         for a in range(pmat.shape[0]):
             for s in range(ecnt[a]):
@@ -224,7 +225,7 @@ def stresses(pos: ti.types.ndarray(), vel: ti.types.ndarray(), pmat: ti.types.nd
                     j = eidx[a, s]
                     r = efor[j]
                     theta = (pmix[a][0] + pmix[elem[a, s, 0]][0] + pmix[elem[a, s, 1]][0]) / 3.0
-                    _element_stress(a, s, j, ti.cast(r[1], ti.i32), ti.cast(r[3], ti.i32),
+                    _element_stress(a, s, j, ti.cast(r[4], ti.i32), ti.cast(r[5], ti.i32),
                                     theta, pos, vel, pmat, matp, elem, ecnt, emult, esig, sigp,
                                     sigc, efor, ede, psig, pfail, elem_old, esig_old, ecnt_old,
                                     esrc, prb, dt, carry, eos, True)
@@ -286,12 +287,24 @@ def _element_stress(a, s, j, jold, cover, theta, pos: ti.template(), vel: ti.tem
     forces, V_e) for the passes that follow (:func:`stresses`)."""
     b = elem[a, s, 0]
     c = elem[a, s, 1]
-    grad, de, area = _kinematics(a, b, c, pos, vel, dt)
+    de = ti.Vector([0.0, 0.0, 0.0])
+    spin = 0.0
+    area = 0.0
     M = pmat[a]
-    kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
     if ti.static(mixed):
+        # the kinematics of pass (a), kept in the record line
+        r = efor[j]
+        de = ti.Vector([r[0], r[1], r[2]])
+        spin = r[3]
+        area = r[7] * r[5] / ti.cast(emult[a, s], ti.f64)
         if mixes(matp, M):
             de = fvm.mixed_strain(de, theta)
+    else:
+        grad, de0, area0 = _kinematics(a, b, c, pos, vel, dt)
+        de = de0
+        area = area0
+        spin = fvm.spin_rate(grad)
+    kind = ti.cast(matp[M, MAT_TYPE], ti.i32)
     sig = ti.Vector([0.0, 0.0, 0.0, 0.0])
     eps = 0.0
     flag = 0
@@ -304,7 +317,7 @@ def _element_stress(a, s, j, jold, cover, theta, pos: ti.template(), vel: ti.tem
                                   elem_old, esig_old, ecnt_old, esrc, prb)
         if not found:
             sig = (psig[a] + psig[b] + psig[c]) / 3.0
-        sig = fvm.jaumann_rotate(sig, fvm.spin_rate(grad), dt) + fvm.elastic_increment(
+        sig = fvm.jaumann_rotate(sig, spin, dt) + fvm.elastic_increment(
             de, matp[M, MAT_K], matp[M, MAT_G])
         if kind == FLUID:
             sig = relax_shear(sig, matp[M, MAT_FLUID_TAU], dt)
