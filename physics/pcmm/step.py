@@ -16,7 +16,8 @@ def update(a, e, dt, time, first, full, carry, eos, serial, mixed=True):
     pair lists and slots). ``first``: the first step of the run; ``full``: rebuild
     everything (first step, after a restore); ``carry``: an element that existed
     last step continues from its own stress; ``eos``: there are particles with an
-    equation of state.
+    equation of state; ``mixed``: the nodal mixed discretization of the elements
+    whose material takes it (:func:`physics.pcmm.stress.stresses`).
 
     pstate[i] = (plastic shear strain, failed (0/1), elements containing i, −).
     """
