@@ -23,7 +23,8 @@ Set-up (the half of the problem right of the footing's centre line, x ≥ 0)
 - Domain: b = 0.5 m; φ = 0: 4b × 2b (Prandtl's mechanism reaches 3b from the
   centre line and b·sqrt(2) deep); φ = 20°: 8b × 3b (its log spiral reaches about
   6b). Bottom fixed; the centre line x = 0 (symmetry) and the far side on vertical
-  rollers (vx = 0).
+  rollers (vx = 0); for particles also frictionless walls there, which hold the
+  rows that start half a spacing from a side (hexagonal lattice, random packing).
 - Footing, pushed down at v = 0.01 m/s (v/c_p ≈ 1e-4: quasi-static): on PCMM
   soil a rigid block (every node driven: a kinematic tool) whose bottom edge spans
   x = −2h to b, touching the soil's surface, coupled to the particles by
@@ -167,6 +168,15 @@ def footing(kind, n, phi_deg=0.0, speed=SPEED, s_end=S_END, sim_kwargs=None, mix
     m.fix(bottom, vx=0.0, vy=0.0)
     m.fix(np.setdiff1d(left, bottom), vx=0.0, vy=None)
     m.fix(np.setdiff1d(right, bottom), vx=0.0, vy=None)
+    if not m.is_fvm:
+        # the centre line and the far side also as frictionless walls, a hair outside
+        # (so that a particle centred on a side has a normal): the rows of a hexagonal
+        # lattice (the inner discs of a random packing) that start half a spacing from
+        # a side are held by them, not only the particles reaching it
+        side = tdem.LinearContact(kn=YOUNG, ks=0.0, friction=0.0)
+        eps = 1e-3 * float(m.r.min())
+        sim.add_wall((-eps, 2.0 * H), (-eps, -H), contact=side)
+        sim.add_wall((W + eps, -H), (W + eps, 2.0 * H), contact=side)
     h = B_HALF / n
     if m.is_fvm:
         # the rigid smooth footing is the surface nodes under it, driven down with
