@@ -288,7 +288,7 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None):
 
 def plots(runs, out, nc0, nc20):
     plt = common.pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4), squeeze=False)
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), squeeze=False)
     for ax, phi, nc in ((axes[0, 0], 0.0, nc0), (axes[0, 1], 20.0, nc20)):
         mine = [r for r in runs if r["phi"] == phi]
         for r in mine:
@@ -301,9 +301,10 @@ def plots(runs, out, nc0, nc20):
         ax.set_xlabel("settlement s / b")
         ax.set_ylabel("q / c")
         ax.set_title(f"φ = {phi:.0f}°", fontsize=10)
-        ax.set_ylim(0, 1.3 * nc)
+        ax.set_ylim(-0.45 * nc if len(mine) > 6 else 0.0, 1.3 * nc)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        ax.legend(fontsize=6, loc="lower right", ncol=2 if len(mine) > 6 else 1,
+                  framealpha=0.8)
     fig.suptitle("Smooth strip footing on weightless soil: load–settlement", fontsize=10)
     fig.tight_layout()
     common.save(fig, out / "load_settlement.png")
