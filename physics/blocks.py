@@ -35,16 +35,6 @@ from .pcmm import viscous_stress
 
 
 @ti.func
-def _mid_kinematics(t, npos: ti.template(), nvel: ti.template(), dt):
-    """Velocity gradient (Eq. 6) and area of triangle t on the mid-step configuration
-    x_n − ½Δt·v_{n−1/2} (module docstring)."""
-    va, vb, vc = nvel[t[0]], nvel[t[1]], nvel[t[2]]
-    h = 0.5 * dt
-    ya, yb, yc = npos[t[0]] - h * va, npos[t[1]] - h * vb, npos[t[2]] - h * vc
-    return fvm.velocity_gradient(ya, yb, yc, va, vb, vc), fvm.area(ya, yb, yc)
-
-
-@ti.func
 def _nodal_mean(v, k, tfor: ti.template(), inc_start: ti.template(), inc: ti.template()):
     """Σ S_e q_e / Σ S_e over the triangles at node v, with (q_e, S_e) in columns
     k, 4 of ``tfor`` (0 where no stressed triangle meets the node)."""
@@ -75,26 +65,28 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
     in-plane mean stress of the nodal forces averaged through the nodes (not
     ``mixed``: each triangle's own). ``tfor`` holds each triangle's kinematics
     between the passes; ``nmix`` (V, 2) the nodal means."""
-    # 1. kinematics: (Δθ, area) per triangle (area 0 for a rigid block's)
-    ti.loop_config(serialize=serial)
-    for e in range(tri.shape[0]):
-        out = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-        # −1: a triangle of a rigid block (no stress); area 0: not in the averages
-        if tmat[e] >= 0 and mixes(matp, ti.max(tmat[e], 0)):
-            grad, s = _mid_kinematics(tri[e], npos, nvel, dt)
-            de = fvm.strain_increment(grad, dt)
-            out = ti.Vector([de[0] + de[1], 0.0, 0.0, 0.0, s, 0.0])
-        tfor[e] = out
-    # 2. the nodes' area-weighted volumetric strain increments
-    ti.loop_config(serialize=serial)
-    for v in range(nmix.shape[0]):
-        nmix[v] = ti.Vector([_nodal_mean(v, 0, tfor, inc_start, inc), 0.0])
+    if ti.static(mixed):
+        # 1. kinematics: (Δθ, area) per triangle (area 0: not in the averages, a
+        #    rigid block's triangle (material −1) or one of a material that does not mix)
+        ti.loop_config(serialize=serial)
+        for e in range(tri.shape[0]):
+            out = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+            if tmat[e] >= 0 and mixes(matp, ti.max(tmat[e], 0)):
+                t = tri[e]
+                grad, s = fvm.mid_step(t[0], t[1], t[2], npos, nvel, dt)
+                de = fvm.strain_increment(grad, dt)
+                out = ti.Vector([de[0] + de[1], 0.0, 0.0, 0.0, s, 0.0])
+            tfor[e] = out
+        # 2. the nodes' area-weighted volumetric strain increments
+        ti.loop_config(serialize=serial)
+        for v in range(nmix.shape[0]):
+            nmix[v] = ti.Vector([_nodal_mean(v, 0, tfor, inc_start, inc), 0.0])
     # 3. stresses with the strain increment's volumetric part the mean of the nodes'
     ti.loop_config(serialize=serial)
     for e in range(tri.shape[0]):
         if tmat[e] >= 0:
             t = tri[e]
-            grad, s = _mid_kinematics(t, npos, nvel, dt)
+            grad, s = fvm.mid_step(t[0], t[1], t[2], npos, nvel, dt)
             de = fvm.strain_increment(grad, dt)
             M = tmat[e]
             if ti.static(mixed):
@@ -112,10 +104,11 @@ def update(npos: ti.types.ndarray(), nvel: ti.types.ndarray(), tri: ti.types.nda
             tstate[e] = st
             sf = sig + viscous_stress(matp, M, de, dt)
             tfor[e] = ti.Vector([sf[0], sf[1], sf[2], sf[3], s, 0.5 * (sf[0] + sf[1])])
-    # 4. the nodes' area-weighted in-plane mean stresses
-    ti.loop_config(serialize=serial)
-    for v in range(nmix.shape[0]):
-        nmix[v][1] = _nodal_mean(v, 5, tfor, inc_start, inc)
+    if ti.static(mixed):
+        # 4. the nodes' area-weighted in-plane mean stresses
+        ti.loop_config(serialize=serial)
+        for v in range(nmix.shape[0]):
+            nmix[v][1] = _nodal_mean(v, 5, tfor, inc_start, inc)
     # 5. nodal forces of each triangle, its in-plane mean stress the mean of the nodes'
     ti.loop_config(serialize=serial)
     for e in range(tri.shape[0]):

@@ -184,6 +184,19 @@ def constitutive(sig):
 
 
 @ti.func
+def mid_step(a, b, c, pos: ti.template(), vel: ti.template(), dt):
+    """Velocity gradient (Eq. 6) and signed area of the triangle of nodes a, b, c on
+    the mid-step configuration x − ½Δt·v (x at step n, v at n − ½): a rigid rotation
+    then has an exactly skew gradient, and Δθ·area is exactly the area change of the
+    step (the area is quadratic in the positions). PCMM elements and block triangles
+    both use it."""
+    va, vb, vc = vel[a], vel[b], vel[c]
+    h = 0.5 * dt
+    ya, yb, yc = pos[a] - h * va, pos[b] - h * vb, pos[c] - h * vc
+    return velocity_gradient(ya, yb, yc, va, vb, vc), area(ya, yb, yc)
+
+
+@ti.func
 def mixed_strain(de, theta):
     """The strain increment de = (Δεxx, Δεyy, Δεxy) with its volumetric part Δθ
     replaced by ``theta`` (the nodal mixed discretization: the mean over the

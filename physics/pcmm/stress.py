@@ -340,12 +340,9 @@ def _element_stress(a, s, j, jold, cover, theta, pos: ti.template(), vel: ti.tem
 def _kinematics(a, b, c, pos: ti.template(), vel: ti.template(), dt):
     """Velocity gradient (Eq. 6), strain increment (Eq. 7) and area of the element
     (a, b, c) on the mid-step configuration x − ½Δt·v: Δθ·area is then exactly the
-    area change of the step (the area is quadratic in the positions)."""
-    va, vb, vc = vel[a], vel[b], vel[c]
-    h = 0.5 * dt
-    ya, yb, yc = pos[a] - h * va, pos[b] - h * vb, pos[c] - h * vc
-    grad = fvm.velocity_gradient(ya, yb, yc, va, vb, vc)
-    return grad, fvm.strain_increment(grad, dt), fvm.area(ya, yb, yc)
+    area change of the step (:func:`physics.fvm.mid_step`)."""
+    grad, area = fvm.mid_step(a, b, c, pos, vel, dt)
+    return grad, fvm.strain_increment(grad, dt), area
 
 
 @ti.func
