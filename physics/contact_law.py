@@ -49,7 +49,8 @@ The parameter table (one row per law used by a simulation, ``lawp``) has the col
 ====  ==========================================================
 0     law code (index in the registry)
 1     rolling resistance delta (B = delta r_bar), 0 = off   (:mod:`physics.rolling`)
-2     rolling model (1 elastic-perfectly plastic, 2 elastic-brittle)
+2     rolling model (1 elastic-perfectly plastic, 2 elastic-brittle Eq. 36, 3 the same
+      with a permanent break)
 3     rolling damping on (1) or off (0)
 4…    the law's ``params``
 ====  ==========================================================
@@ -282,7 +283,7 @@ class ContactLaw:
         r = self.rolling
         if r is None:
             return [0.0, 0.0, 0.0]
-        return [r.delta, float(r.model), 1.0 if r.damping else 0.0]
+        return [r.delta, r.column(), 1.0 if r.damping else 0.0]
 
     def to_dict(self):
         """The constructor's arguments (and ``type``, the class name)."""

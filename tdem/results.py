@@ -143,6 +143,12 @@ class Results:
             fs = np.concatenate([cf + cs[ii, kk, 0][:, None] * normal_dir,
                                  wcf + wcs[wi, wk, 0][:, None] * wn])
             extra = {}
+            if self._rolling3d:
+                # the rolling spring's couple (a vector, on the first), after the law's
+                # columns (physics.rolling.rolling_couple_3d)
+                R3 = _claw.history_width(self._law_set, 3)
+                extra["moment"] = np.concatenate([hist[ii, kk, R3:R3 + 3],
+                                                  whist[wi, wk, R3:R3 + 3]])
             if getattr(self, "_polys", None):
                 # polyhedra: the contact point is the overlap's centroid (a pair keeps
                 # it from the owner in its history; against a triangle the point on the

@@ -213,6 +213,7 @@ class Runner:
 
     def _rebuild_from(self, state, new_particles=None):
         """(Re)allocate every array for the current sizes and fill it from ``state``."""
+        self._built_roll3d = self._rolling3d
         self._set_law_set(state)
         if new_particles is not None:
             pos, vel, r, rho, law, shape, ang, om = new_particles
@@ -801,6 +802,10 @@ class Runner:
                              f"steps={steps!r}")
         if not self._built:
             self._build()
+        elif self._n and self._built_roll3d != self._rolling3d:
+            # 3D rolling resistance switched on or off (law.update) since the arrays were
+            # built: the contacts' rolling columns are added (at zero) or dropped
+            self._rebuild_from(self._download())
         if self._n:
             self._upload_laws()      # a law's parameters may have changed since (law.update)
         if self._cont is not None:

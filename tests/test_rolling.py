@@ -7,7 +7,11 @@ so F_n = K_n u; one disc is spun at a prescribed ω, the relative rotation
 - both models: elastic branch M = −K_m θ_r (on i), K_m = K_n B²/12, B = δ r̄,
   r̄ = 2 r_i r_j/(r_i + r_j) (2 r_i against a wall);
 - Model 1: |M| ≤ M₀ = F_n B/6 (perfectly plastic), elastic unloading on reversal;
-- Model 2: M drops to 0 once |θ_r| > θ_r⁰ = 2 F_n/(K_n B) and stays 0.
+- Model 2 (Eq. 36 as written): M = −K_m θ_r while |θ_r| <= θ_r⁰ = 2 F_n/(K_n B), 0
+  above, so the couple comes back when the rotation returns; with
+  ``permanent_break=True`` it stays 0 once it has dropped;
+- θ_r counts from the moment the rolling model is switched on (Jiang: θ_r = 0 ↔ M = 0):
+  a contact that rolled while the model was off starts from M = 0.
 """
 
 import numpy as np
@@ -20,7 +24,7 @@ DT, DT_WALL = 4e-4, 1.5e-4   # the yield rotation is reached in 150 and 133 step
 RI, RJ = 0.1, 0.05
 
 
-def spin_pair(model, w, t_rev, until, wall=False, every=2):
+def spin_pair(model, w, t_rev, until, wall=False, every=2, permanent=False):
     """Disc 0 spun at ω = w until t_rev, then at −w, against disc 1 (held, not
     spinning) or a wall. Returns (θ_r, M, F_n) at the recorded steps, θ_r the
     relative rotation the contact has accumulated in those steps."""
@@ -31,7 +35,8 @@ def spin_pair(model, w, t_rev, until, wall=False, every=2):
 
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt=dt)
     law = tdem.LinearContact(kn=KN, ks=KN, friction=0.5,
-                             rolling=tdem.RollingResistance(delta=DELTA, model=model))
+                             rolling=tdem.RollingResistance(delta=DELTA, model=model,
+                                                            permanent_break=permanent))
     if wall:
         sim.add_particles([[0.0, RI - U]], RI, density=1000.0, contact=law)
         sim.add_wall((-1.0, 0.0), (1.0, 0.0), contact=law)
@@ -90,11 +95,12 @@ def test_model1_elastic_then_perfectly_plastic(wall):
 
 
 @pytest.mark.parametrize("wall", [False, True])
-def test_model2_elastic_then_brittle(wall):
+def test_model2_permanent_break(wall):
     fn_ref, km, m0, theta0 = reference(wall)
     w = 1.0
     t_rev = 1.5 * theta0 / w
-    theta, mom, fn = spin_pair(2, w, t_rev, until=4 * t_rev, wall=wall, every=1)
+    theta, mom, fn = spin_pair(2, w, t_rev, until=4 * t_rev, wall=wall, every=1,
+                               permanent=True)
     assert fn == pytest.approx(np.full_like(fn, fn_ref), rel=1e-9)
     intact = np.nonzero(mom != 0.0)[0]
     el = np.abs(mom[intact]) < 0.9 * m0
@@ -113,11 +119,64 @@ def test_model2_elastic_then_brittle(wall):
     assert theta[-1] < -theta0
 
 
+@pytest.mark.parametrize("wall", [False, True])
+def test_model2_is_eq36_as_written(wall):
+    """Eq. 36 read as a function of θ_r: the couple is −K_m θ_r inside |θ_r| <= θ_r⁰
+    and zero outside, on the way out (+θ_r⁰), back (the couple returns below θ_r⁰),
+    through zero and out again past −θ_r⁰."""
+    fn_ref, km, m0, theta0 = reference(wall)
+    w = 1.0
+    t_rev = 1.5 * theta0 / w
+    theta, mom, fn = spin_pair(2, w, t_rev, until=4 * t_rev, wall=wall, every=1)
+    step = w * (DT_WALL if wall else DT)
+    inside = np.abs(theta) < theta0 - 1.5 * step
+    outside = np.abs(theta) > theta0 + 1.5 * step
+    assert inside.sum() > 200 and outside.sum() > 100
+    assert mom[inside] == pytest.approx(-km * theta[inside], rel=1e-9, abs=1e-3 * m0)
+    assert np.all(mom[outside] == 0.0)
+    # it was out, came back (a couple after the first drop) and went out the other way
+    first_out = np.argmax(outside)
+    back = inside & (np.arange(len(theta)) > first_out)
+    assert back.sum() > 200
+    assert theta.min() < -theta0 and mom[-1] == 0.0
+
+
 @pytest.mark.parametrize("model", [1, 2])
-def test_energy_account_through_yield_and_break(model):
+@pytest.mark.parametrize("dim", [2, 3])
+def test_rotation_counts_from_the_switch_on(model, dim):
+    """A contact that rolled while the rolling resistance was off (as during a
+    specimen's preparation) starts from M = 0 when the model is switched on: the
+    couple is −K_m times the rotation since then (Jiang: θ_r = 0 corresponds to M = 0).
+    Before the fix the rotation of the preparation counted in 2D, and a Model 2 contact
+    started broken; in 3D a law given rolling resistance after the arrays were built
+    had no rolling columns, and rolled on without a couple."""
+    fn_ref, km, m0, theta0 = reference()
+    w, dt = 1.0, DT
+    sim = tdem.Simulation(dim=dim, gravity=(0.0,) * dim, dt=dt)
+    law = tdem.LinearContact(kn=KN, ks=KN, friction=0.5)
+    pos = np.array([[0.0, 0.0, 0.0], [RI + RJ - U, 0.0, 0.0]])[:, :dim]
+    sim.add_particles(pos, [RI, RJ], density=1000.0, contact=law)
+    held = dict(vx=0.0, vy=0.0) if dim == 2 else dict(vx=0.0, vy=0.0, vz=0.0)
+    spin = (lambda x: x) if dim == 2 else (lambda x: (0.0, 0.0, x))
+    sim.fix_particles([1], omega=spin(0.0), **held)
+    sim.fix_particles([0], omega=spin(w), **held)
+    sim.run(steps=400)                      # rolls 0.16 rad = 2.7 θ_r⁰ with the model off
+    law.update(rolling=tdem.RollingResistance(delta=DELTA, model=model))
+    sim.run(steps=60)                       # 0.024 rad since the switch: elastic in both
+    c = sim.contacts.numpy()
+    moment = c["moment"][0] if dim == 2 else c["moment"][0][2]
+    # the first step after the switch sees the rotation of that step (ω held at w)
+    assert moment == pytest.approx(-km * 60 * w * dt, rel=1e-6)
+    assert c["normal"][0] == pytest.approx(fn_ref, rel=1e-9)
+
+
+@pytest.mark.parametrize("model, permanent", [(1, False), (2, False), (2, True)])
+def test_energy_account_through_yield_and_break(model, permanent):
     """The driven disc does work on the contact (booked as boundary work); it goes
     into the rolling spring and into dissipation (plastic rolling; for Model 2 the
-    spring's energy M₀²/(2 K_m) = 0.167 J released at the break). The total stays
+    spring's energy M₀²/(2 K_m) = 0.167 J released at the break; read as Eq. 36 the
+    couple drops at +θ_r⁰, comes back at +θ_r⁰ on the way back (−0.167 J booked as
+    the spring takes its energy back) and drops again at −θ_r⁰). The total stays
     constant through yield, reversal and break (before the fix of the break booking
     it dropped by 0.167 J). Frictionless, so that only the couple works; dt = 1e-4 s
     because the account pairs the work of the prescribed spin at step n with the
@@ -127,7 +186,8 @@ def test_energy_account_through_yield_and_break(model):
     dt = 1e-4
     sim = tdem.Simulation(gravity=(0.0, 0.0), dt=dt)
     law = tdem.LinearContact(kn=KN, ks=KN, friction=0.0,
-                             rolling=tdem.RollingResistance(delta=DELTA, model=model))
+                             rolling=tdem.RollingResistance(delta=DELTA, model=model,
+                                                            permanent_break=permanent))
     sim.add_particles([[0.0, 0.0], [RI + RJ - U, 0.0]], [RI, RJ], density=1000.0, contact=law)
     sim.fix_particles([1], vx=0.0, vy=0.0, omega=0.0)
     t_rev = 1.5 * theta0
@@ -151,3 +211,40 @@ def test_energy_account_through_yield_and_break(model):
     assert e1["boundary_work"] > 0.1
     released = m0 ** 2 / (2 * km)
     assert np.abs(h[:, 0] - e0["total"]).max() < 0.01 * released
+
+
+@pytest.mark.parametrize("permanent", [False, True])
+def test_model2_in_3d_returns_as_eq36_or_stays_broken(permanent):
+    """The vector form in 3D: two spheres pressed together along x, one spun about z
+    out past θ_r⁰ and back: inside |θ_r| <= θ_r⁰ the couple is −K_m θ_r (about z),
+    outside zero; back inside it returns (Eq. 36) or stays zero (permanent break)."""
+    fn_ref, km, m0, theta0 = reference()
+    w, dt = 1.0, DT
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), dt=dt)
+    law = tdem.LinearContact(kn=KN, ks=KN, friction=0.5,
+                             rolling=tdem.RollingResistance(delta=DELTA, model=2,
+                                                            permanent_break=permanent))
+    sim.add_particles([[0.0, 0.0, 0.0], [RI + RJ - U, 0.0, 0.0]], [RI, RJ],
+                      density=1000.0, contact=law)
+    sim.fix_particles([1], vx=0.0, vy=0.0, vz=0.0, omega=(0.0, 0.0, 0.0))
+    sim.fix_particles([0], vx=0.0, vy=0.0, vz=0.0, omega=(0.0, 0.0, w))
+
+    def couple():
+        c = sim.contacts.numpy()
+        return np.asarray(c["moment"][0], float)
+
+    n_out = int(round(0.5 * theta0 / (w * dt)))
+    sim.run(steps=n_out)                                  # θ_r = θ_r⁰/2: elastic
+    m = couple()
+    # (the first step sees ω = 0: the spin is imposed at the end of a step)
+    assert m[2] == pytest.approx(-km * (n_out - 1) * w * dt, rel=1e-6)
+    assert np.abs(m[:2]).max() < 1e-9 * m0
+    sim.run(steps=2 * n_out)                              # θ_r = 1.5 θ_r⁰: dropped
+    assert np.abs(couple()).max() == 0.0
+    sim.fix_particles([0], vx=0.0, vy=0.0, vz=0.0, omega=(0.0, 0.0, -w))
+    sim.run(steps=2 * n_out)                              # back to θ_r⁰/2
+    m = couple()
+    if permanent:
+        assert np.abs(m).max() == 0.0
+    else:
+        assert m[2] == pytest.approx(-0.5 * km * theta0, rel=0.02)
