@@ -10,7 +10,11 @@ with sigma_h held by servo-controlled side walls. The mobilised friction angle i
 sin(phi) = (sigma_v - sigma_h)/(sigma_v + sigma_h). Rolling resistance (shape
 parameter delta, Model 1 elastic-perfectly plastic or Model 2 elastic-brittle) is
 off while the specimen is made and switched on for the compression, so that every
-test of one confining stress starts from the same specimen.
+test of one confining stress starts from the same specimen; each contact's relative
+rotation theta_r counts from that switch (the paper: theta_r = 0 corresponds to M = 0).
+Model 2 is Eq. 36 as written: M = K_m theta_r while |theta_r| <= 2 F_n/(K_n B), zero
+above, as a function of theta_r (``tdem.RollingResistance``; ``permanent_break=True``
+is the other reading, a contact's couple gone for good once it has dropped).
 
 Targets (the paper's text): peak/residual phi = 24.4°/19.3° without rolling
 resistance, 29.0°/23.0° for Model 1 and 26.5°/20.7° for Model 2 at delta = 0.4,
