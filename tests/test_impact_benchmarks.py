@@ -200,6 +200,8 @@ def test_sliding_checks_compare_only_the_sliding_points():
 
 
 # ------------------------------------------------------------------ the case
+# (the whole quick preset: the tests above check its physics one by one, in the default run)
+@pytest.mark.slow
 def test_quick_preset_writes_a_passing_summary(tmp_path):
     s = ib.main(["--preset", "quick", "--out", str(tmp_path)])
     with open(tmp_path / "summary.json") as f:
