@@ -96,6 +96,9 @@ def test_water_blocks_duration_is_checked(tmp_path):
     assert not (tmp_path / "wb" / "summary.json").exists()
 
 
+# (three processes building the water and the blocks, about 45 s on 2 cores; the case
+# itself is checked in the default run by tests/test_water_blocks.py)
+@pytest.mark.slow
 def test_water_blocks_systems_in_parallel_give_the_same_run(tmp_path):
     """water_blocks --parallel runs the two block systems in two processes: on one
     thread each, every record of both systems equals the run one after the other,
