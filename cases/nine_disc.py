@@ -484,7 +484,10 @@ def main(argv=None):
             "C&S Fig. 6 curve 1: amplitude about 0.15 F_eq (tolerance decided here: 10 %). "
             f"Half the peak-to-peak range after the walls stop ({hold} cycles). It is set "
             f"by dt: {DT_FRACTION} of the critical step here, which C&S do not give "
-            "(module docstring; the paper preset's dt_sweep.png)"),
+            "(module docstring; the paper preset's dt_sweep.png). The ratio is a "
+            "function of the ramp's duration 40 dt alone: 40 x 0.12 critical steps gives "
+            "0.151, and 0.148 in 80 steps of half the size "
+            "(tests/test_nine_disc.py)"),
         common.check(
             "undamped_mean_over_F_eq", mean_u / f_eq, 1.0, common.rel(0.02), "",
             "the undamped force oscillates about F_eq (within 2 %)"),

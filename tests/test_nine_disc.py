@@ -86,3 +86,30 @@ def test_slower_loading_leaves_smaller_oscillation(runs):
     assert m_slow == pytest.approx(m_fast, rel=0.01)
     print(f"fast/slow amplitude = {a_fast / a_slow:.3f}")
     assert a_fast > 1.2 * a_slow
+
+
+def _ratio(speed=0.12, dt_fraction=nd.DT_FRACTION, load_cycles=nd.LOAD_CYCLES):
+    """Undamped amplitude / F_eq after a ramp of ``load_cycles`` steps of
+    ``dt_fraction`` critical steps, watched for the same time after it."""
+    hold = int(round(400 * nd.DT_FRACTION / dt_fraction))
+    kw = dict(speed=speed, dt_fraction=dt_fraction, load_cycles=load_cycles, hold=hold)
+    undamped = nd.compression(**kw)
+    damped = nd.compression(damped=True, **kw)
+    return nd.oscillation(undamped)[1] / damped.fn[-1]
+
+
+def test_the_amplitude_is_set_by_the_ramps_duration_which_cs_do_not_give():
+    """Why the undamped amplitude (C&S Fig. 6: about 0.15 F_eq) is not met at the
+    preset's step: the array is linear, so amplitude / F_eq does not depend on the
+    walls' speed, and it is a function of the ramp's duration alone (40 cycles × dt),
+    the same when that duration is cut into twice as many steps. C&S give neither dt
+    nor its fraction of the critical step: a ramp of 40 × 0.12 = 4.8 critical steps
+    gives their 0.15 (measured 0.151, 0.148, 0.148 in 40, 80 and 160 steps); the
+    preset's 40 × 0.2 = 8 gives 0.048 (0.030 and 0.027 in 80 and 160 steps: near a
+    node of the ramp's response the leapfrog's period error shows)."""
+    cs = [_ratio(dt_fraction=0.12 / k, load_cycles=40 * k) for k in (1, 2)]
+    assert _ratio(speed=0.04, dt_fraction=0.12) == pytest.approx(cs[0], rel=1e-3)
+    assert cs[0] == pytest.approx(0.15, rel=0.03)
+    assert abs(cs[1] - cs[0]) < 0.03 * cs[1]
+    preset = [_ratio(dt_fraction=0.2 / k, load_cycles=40 * k) for k in (1, 2)]
+    assert preset[0] < 0.35 * cs[0] and preset[1] < 0.25 * cs[1]
