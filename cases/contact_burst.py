@@ -28,10 +28,12 @@ monitor positions, so compare the decay, not the values).
 
 Read-outs (summary.json)
 ------------------------
-- P1 start time: the first time |u_x(P1)| exceeds 1 % of its largest value in the
+- P1 start time as the paper words it ("increases linearly after 0.46 ms"): the line
+  fitted to |u_x(P1)| over its rise from 10 % to 50 % of its largest value in the
   first millisecond (later, P1 may be thrown out with the crater's ejecta, whose
-  flight would set the scale), and, for scale, the P-wave and Rayleigh-wave arrival
-  times from the charge's contact point;
+  flight would set the scale), extrapolated back to zero (``linear_rise_start``);
+  P1's first motion (|u_x| above 1 % of that value), and, for scale, the P-wave and
+  Rayleigh-wave arrival times from the charge's contact point;
 - P4-P6 peak pressures and the ratios P5/P4, P6/P4 beside the paper's;
 - crater at the end (3.6 ms), from the rock's free surface: per column one
   diameter wide, the top of the rock body counted up from below (discs above a gap
@@ -130,6 +132,23 @@ def build(cfg, arch=None, threads=None):
         mon[k] = int(rock.ids[np.argmin(np.hypot(x - W / 2, y - (H - d)))])
     return dict(sim=sim, rock=rock, charge=charge, monitors=mon, x0=np.asarray(pos, float),
                 centre=centre, R=R)
+
+
+def linear_rise_start(t, u, lo=0.1, hi=0.5, window=START_WINDOW):
+    """Where a displacement's linear rise starts (the paper: P1 "increases linearly
+    after 0.46 ms"): the line fitted to |u| over its rise from ``lo`` to ``hi`` of its
+    largest value within ``window``, extrapolated back to |u| = 0. None without a rise."""
+    t, a = np.asarray(t, float), np.abs(np.asarray(u, float))
+    early = t <= window
+    big = a[early].max() if early.any() else 0.0
+    if not big > 0.0:
+        return None
+    i0 = int(np.argmax(a >= lo * big))
+    i1 = i0 + int(np.argmax(a[i0:] >= hi * big))
+    if i1 - i0 < 2:
+        return None
+    slope, icpt = np.polyfit(t[i0:i1 + 1], a[i0:i1 + 1], 1)
+    return float(-icpt / slope) if slope > 0.0 else None
 
 
 def surface_profile(x, r, x0, x1, dx):
@@ -258,11 +277,13 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
     hist = sim.histories()
     width, depth, xs, top = crater(p, m)
 
-    # P1 start: |u_x| above 1 % of its largest value in the first millisecond
+    # P1's first motion: |u_x| above 1 % of its largest value in the first
+    # millisecond; its start as the paper words it: where its linear rise begins
     t1, u1 = (np.asarray(a) for a in hist["P1"])
     early = t1 <= START_WINDOW
     big = np.abs(u1[early]).max() if early.any() else 0.0
-    start = float(t1[np.argmax(np.abs(u1) > 0.01 * big)]) if big > 0 else None
+    moves = float(t1[np.argmax(np.abs(u1) > 0.01 * big)]) if big > 0 else None
+    start = linear_rise_start(t1, u1)
     mat = tdem.MohrCoulomb(**ROCK)
     c_p = mat.p_wave_speed
     c_s = math.sqrt(mat.shear / mat.density)
@@ -293,13 +314,15 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
             f"{sim.time * 1e3:.2f} ms: reported, not compared"))
     checks.append(common.check(
         "P1_start", start, PAPER["P1_start_s"], common.rel(0.10), "s",
-        "first |u_x| > 1 % of its maximum in the first ms; the paper's 0.46 ms (its "
-        "threshold is not given) is nearer the Rayleigh wave's arrival "
-        f"({dist / c_r * 1e3:.2f} ms) than the P-wave's ({dist / c_p * 1e3:.2f} ms); "
-        "within 10 % (decided here)"))
+        "where |u_x|'s linear rise starts, as the paper words it ('increases linearly "
+        "after 0.46 ms'): the line fitted to |u_x| over its rise from 10 % to 50 % of "
+        "its largest value in the first ms, extrapolated to zero (decided here); the "
+        f"Rayleigh wave arrives at {dist / c_r * 1e3:.2f} ms, the P-wave at "
+        f"{dist / c_p * 1e3:.2f} ms; within 10 % (decided here)"))
     checks.append(common.check(
-        "P1_start_vs_p_wave", start, dist / c_p, common.rel(0.10), "s",
-        "the same start against the P-wave's arrival from the charge's contact point "
+        "P1_first_motion_vs_p_wave", moves, dist / c_p, common.rel(0.10), "s",
+        "P1's first motion (|u_x| > 1 % of its maximum in the first ms) against the "
+        "P-wave's arrival from the charge's contact point "
         f"(c_p = {c_p:.0f} m/s, {dist:.2f} m): P1 starts to move when the P-wave arrives"))
     for k, v in peaks.items():
         checks.append(common.check(
@@ -315,7 +338,7 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None):
         "particles": {"rock": len(m["rock"].ids), "charge": len(m["charge"].ids)},
         "radius_m": R, "dt_s": sim.dt, "steps": sim.steps, "time_s": sim.time,
         "crater": {"width_m": width, "depth_m": depth},
-        "P1_start_s": start,
+        "P1_start_s": start, "P1_first_motion_s": moves,
         "P1_arrivals_s": {"p_wave": dist / c_p, "rayleigh": dist / c_r},
         "peak_pressure_Pa": peaks,
         "peak_ratio": ratio,

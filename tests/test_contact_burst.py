@@ -34,8 +34,24 @@ def test_p1_starts_moving_with_the_p_wave(first_ms):
     threshold of "starts to move" is not given). Measured 0.233 ms, 9.9 % early:
     the swelling products spread along the surface and load it nearer P1 than the
     contact point (0.225 ms with the rock's R = 0.04 m)."""
-    start = common.checks_by_name(first_ms)["P1_start"]["value"]
+    start = common.checks_by_name(first_ms)["P1_first_motion_vs_p_wave"]["value"]
+    assert start == first_ms["data"]["P1_first_motion_s"]
     assert start == pytest.approx(first_ms["data"]["P1_arrivals_s"]["p_wave"], rel=0.10)
+
+
+def test_linear_rise_start_is_the_foot_of_the_rise():
+    """The start of a linear rise (the paper's reading of P1) on a synthetic record:
+    at rest, a slow precursor (1 % of the peak), then a linear rise from 0.46 ms to a
+    peak at 0.8 ms: the foot of the rise is found within 1 % of 0.46 ms, and the 1 %
+    threshold (first motion) is earlier, in the precursor."""
+    t = np.linspace(0.0, 1.0e-3, 2001)
+    u = np.where(t > 0.2e-3, 0.01 * (t - 0.2e-3) / 0.26e-3, 0.0)
+    u = np.where(t > 0.46e-3, 0.01 + (t - 0.46e-3) / 0.34e-3, u)
+    u = np.where(t > 0.8e-3, 1.01, u)
+    start = contact_burst.linear_rise_start(t, -u)      # a leftward displacement
+    assert start == pytest.approx(0.46e-3 - 0.01 * 0.34e-3, rel=1e-3)
+    assert start == pytest.approx(0.46e-3, rel=0.01)
+    assert contact_burst.linear_rise_start(t, 0.0 * t) is None
 
 
 def test_crater_reported_not_compared_before_3_6_ms(first_ms):
