@@ -85,10 +85,12 @@ def rolling_couple(lawp: ti.template(), L, fn_el, kn, cn, rbar, dw, dt, m_old, t
         km = kn * b * b / 12.0
         m_trial = m_old - km * dw * dt
         m = m_trial
+        capped = False
         if model == 1:
             m0 = ti.max(fn_el, 0.0) * b / 6.0
             if ti.abs(m) > m0:
                 m = ti.math.sign(m) * m0
+                capped = True
         else:
             th0 = 2.0 * ti.max(fn_el, 0.0) / (kn * b)
             if ti.abs(th) > th0 or (model == MODEL2_PERMANENT and brk > 0.5):
@@ -97,13 +99,11 @@ def rolling_couple(lawp: ti.template(), L, fn_el, kn, cn, rbar, dw, dt, m_old, t
             else:
                 brk = 0.0
                 m = -km * th
-        limited = m != m_trial
-        # energy of a plastic or brittle step: mean of the old and new couple times
-        # the plastic rotation (M_trial − M)/K_m (module docstring)
-        if limited:
-            diss += 0.5 * (m_old + m) * (m_trial - m) / km
+        # plastic or brittle change: mean couple times the plastic rotation
+        # (M_trial − M)/K_m (module docstring); zero on the elastic branch
+        diss += 0.5 * (m_old + m) * (m_trial - m) / km
         m_tot = m
-        if lawp[L, COL_ROLL_DAMP] > 0.5 and brk < 0.5 and not (model == 1 and limited):
+        if lawp[L, COL_ROLL_DAMP] > 0.5 and brk < 0.5 and not capped:
             mu_m = cn * b * b / 12.0
             m_tot -= mu_m * dw
             diss += mu_m * dw * dw * dt
@@ -132,8 +132,8 @@ def rolling_couple_3d(lawp: ti.template(), L, fn_el, kn, cn, rbar, dw, n, dt, m_
     kept, like the shear spring) takes the increment −K_m Δθ_r, Model 1 caps |M| at
     F_n B/6, Model 2 is −K_m θ_r while |θ_r| <= 2 F_n/(K_n B) and zero above (or zero
     for good, with a permanent break), and the rolling dashpot μ_m (module docstring)
-    acts on the rolling rate while the spring is neither capped nor broken. dw = ω_i − ω_j, n the contact normal. Returns (spring couple, total
-    couple on i, accumulated θ_r, broken flag, dissipated energy)."""
+    acts on the rolling rate while the spring is neither capped nor broken.
+    dw = ω_i − ω_j, n the contact normal. Returns (spring couple, total couple on i, accumulated θ_r, broken flag, dissipated energy)."""
     delta = lawp[L, COL_ROLL_DELTA]
     model = ti.cast(lawp[L, COL_ROLL_MODEL], ti.i32)
     wr = dw - dw.dot(n) * n
