@@ -147,7 +147,10 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None, duration
     """Run the case; returns the summary dict (also written to out/summary.json).
     ``duration`` (s) ends the run earlier than T_END (the pulse has passed the
     station at x = 10 m by 6 ms)."""
-    until = T_END if duration is None else float(duration)
+    try:
+        until = T_END if duration is None else float(duration)
+    except (TypeError, ValueError):
+        until = float("nan")
     if not 0.0 < until <= T_END:
         raise InputError(f"duration must lie in (0, {T_END}] s, got {duration!r}")
     out = common.output_dir(CASE, out)
