@@ -56,7 +56,7 @@ from physics.validate import in_range, non_negative, positive
 
 from tdem.errors import InputError
 from tdem.simulation import Simulation
-from tdem.step import W_LAW
+from tdem.step import W_CY, W_LAW, W_Y0, W_Y1
 
 #: The specimens of Jiang, Yu & Harris (2005), §5.
 PAPER = {
@@ -278,6 +278,38 @@ class Specimen:
                            f"{max_steps} steps (void ratio {self.void_ratio():.4f}, "
                            f"stresses {self.stresses()})")
 
+    def _move_wall_to(self, wall, y):
+        """Translate a horizontal wall (bottom or top) to height ``y`` at once."""
+        rows = self.sim._wall_rows()
+        dy = float(y) - float(rows[wall.index, W_Y0])
+        for c in (W_Y0, W_Y1, W_CY):
+            rows[wall.index, c] += dy
+        self.sim._set_wall_rows(rows)
+
+    def settle(self, chunk=500, tolerance=1e-3, max_steps=100000):
+        """Walls at rest; run until the mean wall stress changes by less than
+        ``tolerance`` of itself (or of 1 kPa) from one chunk to the next."""
+        self.stop_walls()
+        prev = None
+        for _ in range(max(1, max_steps // chunk)):
+            s = float(np.mean(self._mean_stresses(chunk)))
+            if prev is not None and abs(s - prev) < tolerance * max(abs(s), 1e3):
+                return s
+            prev = s
+        return prev
+
+    def band_void_ratios(self, bands):
+        """Void ratio of ``bands`` equal horizontal bands of the specimen, from the
+        disc areas inside each band (exact disc–band intersection)."""
+        p = self.sim.particles.numpy()
+        x, r = p["position"], p["radius"]
+        _, _, y0, y1 = self.box()
+        edges = np.linspace(y0, y1, int(bands) + 1)
+        solid = np.zeros(int(bands))
+        for b in range(int(bands)):
+            solid[b] = np.sum(_disc_area_between(x[:, 1], r, edges[b], edges[b + 1]))
+        return (self.width * np.diff(edges) - solid) / solid
+
     def _mean_stresses(self, steps, samples=10):
         """Run ``steps`` steps and return the mean (sigma_h, sigma_v) over ``samples``
         evenly spaced readings."""
@@ -341,6 +373,18 @@ class Specimen:
 
 
 _INWARD = {"left": (1.0, 0.0), "right": (-1.0, 0.0), "bottom": (0.0, 1.0), "top": (0.0, -1.0)}
+
+
+def _segment_area(r, h):
+    """Area of the part of a disc of radius ``r`` below a chord at height ``h`` above
+    its centre (h in [-r, r])."""
+    h = np.clip(h, -r, r)
+    return r * r * np.arccos(-h / r) + h * np.sqrt(np.maximum(r * r - h * h, 0.0))
+
+
+def _disc_area_between(yc, r, lo, hi):
+    """Area of each disc (centre height ``yc``, radius ``r``) between y = lo and hi."""
+    return _segment_area(r, hi - yc) - _segment_area(r, lo - yc)
 
 
 def _lattice(n, aspect, spacing, rng):
@@ -444,6 +488,122 @@ def prepare(n=PAPER["n"], void_ratio=PAPER["void_ratio"], confining=200e3,
         law.update(friction=friction)
         spec.consolidate(confining, max_speed=max_speed)
         record(friction)
+    spec.history = hist
+    spec.grading = grading(d)
+    spec.target_void_ratio = void_ratio
+    return spec
+
+
+def layer_heights(areas, width, void_ratio, undercompaction):
+    """Heights (m) to which the top wall compacts each layer of the multi-layer
+    under-compaction method (Jiang, Konrad & Leroueil 2003): layer i is pressed to
+    its share of the final height inflated by U_i, over the layers below at theirs,
+
+        h_i = (1 + e) [A_1 + ... + A_(i-1) + (1 + U_i) A_i] / W,
+        U_i = U_1 (L - i) / (L - 1),
+
+    ``areas`` the layers' disc areas A_i (m²), ``undercompaction`` U_1 (the first
+    layer's), falling linearly to 0 at the last layer, so that the last one sets the
+    specimen to ``void_ratio`` exactly; the later layers' compaction presses the
+    earlier ones down to it."""
+    a = np.asarray(areas, dtype=float)
+    n = len(a)
+    u = undercompaction * (n - 1 - np.arange(n)) / max(n - 1, 1)
+    below = np.concatenate([[0.0], np.cumsum(a)[:-1]])
+    return (1.0 + void_ratio) * (below + (1.0 + u) * a) / width
+
+
+def prepare_layers(n=PAPER["n"], void_ratio=PAPER["void_ratio"], width=PAPER["width"],
+                   layers=5, undercompaction=0.2, kn=PAPER["kn"], ks=PAPER["ks"],
+                   friction=PAPER["friction"], compaction_friction=None, density=2650.0,
+                   dmin=PAPER["dmin"], dmax=PAPER["dmax"], d50=PAPER["d50"], cu=PAPER["cu"],
+                   seed=0, local_damping=0.7, dt_fraction=0.2, speed=0.5, check_every=25,
+                   arch=None, threads=None, check_interval=100):
+    """A specimen made by multi-layer under-compaction (Jiang, Konrad & Leroueil 2003,
+    the method of Jiang, Yu & Harris 2005): ``layers`` layers of discs added one at a
+    time on a loose lattice above the ones before, each pressed by the top wall (at
+    ``speed``, slowing down over the last two diameters) to :func:`layer_heights`, with
+    ``compaction_friction`` (default: the material's ``friction``) and no gravity; the
+    side walls stand ``width`` apart. The last layer brings the specimen to
+    ``void_ratio`` exactly; it is then left to relax with the walls at rest and the
+    material's friction. Each layer holds a random, size-stratified share of the
+    grading. Not consolidated: :meth:`Specimen.consolidate` brings a copy to each
+    confining stress, so that all start from the same fabric and void ratio (the paper).
+
+    ``history`` holds each layer's compaction height and the void ratios of the
+    layers' bands at the end (:meth:`Specimen.band_void_ratios`), the measure of the
+    method's aim, a homogeneous specimen."""
+    if int(n) != n or n < 4:
+        raise InputError(f"n must be a whole number >= 4, got {n!r}")
+    if int(layers) != layers or not 1 <= layers <= n:
+        raise InputError(f"layers must be a whole number from 1 to n={n}, got {layers!r}")
+    void_ratio = positive("void_ratio", void_ratio)
+    width = positive("width", width)
+    undercompaction = in_range("undercompaction", undercompaction, 0.0, 1.0)
+    speed = positive("speed", speed)
+    friction = non_negative("friction", friction)
+    mu_c = friction if compaction_friction is None else non_negative(
+        "compaction_friction", compaction_friction)
+    rng = np.random.default_rng(seed)
+    d = gradation(n, dmin, dmax, d50, cu, seed=seed)
+    # stratified by size: sorted diameters dealt in turn to the layers, then shuffled
+    d = np.sort(d)
+    layer_of = np.empty(int(n), dtype=int)
+    for k in range(0, int(n), int(layers)):
+        m = min(int(layers), int(n) - k)
+        layer_of[k:k + m] = rng.permutation(int(layers))[:m]
+    r = 0.5 * d
+    parts = [rng.permutation(r[layer_of == i]) for i in range(int(layers))]
+    areas = [float(np.sum(np.pi * p * p)) for p in parts]
+    heights = layer_heights(areas, width, void_ratio, undercompaction)
+    spacing = _LATTICE_SPACING * dmax
+    nx = max(1, int(width // spacing))
+    rows_max = max(int(math.ceil(len(p) / nx)) for p in parts)
+    tall = heights[-1] + (rows_max + 2) * spacing
+    law = LinearContact(kn=kn, ks=ks, friction=mu_c)
+    wall_law = LinearContact(kn=kn, ks=ks, friction=0.0)
+    sim = Simulation(gravity=(0.0, 0.0), local_damping=local_damping, dt_fraction=dt_fraction,
+                     arch=arch, threads=threads, check_interval=check_interval)
+    ox = _WALL_OVERHANG * width
+    walls = {
+        "bottom": sim.add_wall((-ox, 0.0), (width + ox, 0.0), contact=wall_law),
+        "right": sim.add_wall((width, -ox), (width, tall + ox), contact=wall_law),
+        "top": sim.add_wall((width + ox, tall), (-ox, tall), contact=wall_law),
+        "left": sim.add_wall((0.0, tall + ox), (0.0, -ox), contact=wall_law),
+    }
+    spec = Specimen(sim, walls, law, wall_law, friction, float(sum(areas)))
+    base = 0.0
+    top = walls["top"]
+    hist = {"layer_height": [], "layer_steps": [], "layer_stress": []}
+    for i, part in enumerate(parts):
+        rows = int(math.ceil(len(part) / nx))
+        y0 = base + 0.5 * spacing + 0.5 * dmax
+        sites = (np.stack(np.meshgrid(np.arange(nx), np.arange(rows)), -1).reshape(-1, 2)
+                 + 0.5) * np.array([width / nx, spacing])
+        keep = np.sort(rng.choice(len(sites), size=len(part), replace=False))
+        xy = sites[keep] + np.array([0.0, y0 - 0.5 * spacing])
+        spec._move_wall_to(top, y0 + rows * spacing)
+        sim.add_particles(xy, part, density=density, contact=law)
+        start = sim.steps
+        target = float(heights[i])
+        while True:
+            y = spec.box()[3]
+            if y <= target + 1e-9 * dmax:
+                break
+            v = speed * min(1.0, max(0.02, (y - target) / (2.0 * dmax)))
+            top.velocity = (0.0, -min(v, (y - target) / (check_every * sim.dt)))
+            sim.run(steps=check_every)
+        top.velocity = (0.0, 0.0)
+        hist["layer_height"].append(spec.box()[3])
+        hist["layer_steps"].append(sim.steps - start)
+        hist["layer_stress"].append(spec.stresses()[1])
+        base = spec.box()[3]
+    law.update(friction=friction)
+    spec.settle()
+    hist["band_void_ratio"] = spec.band_void_ratios(int(layers)).tolist()
+    hist["undercompaction"] = float(undercompaction)
+    hist["compaction_friction"] = float(mu_c)
+    hist["layers"] = int(layers)
     spec.history = hist
     spec.grading = grading(d)
     spec.target_void_ratio = void_ratio

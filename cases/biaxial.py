@@ -22,14 +22,44 @@ resistance, 29.0°/23.0° for Model 1 and 26.5°/20.7° for Model 2 at delta = 0
 
 Decisions the paper leaves open
 -------------------------------
-- Specimen preparation: the paper uses multi-layer under-compaction (its ref. 58).
-  Here (``cases._specimen.prepare``): discs on a loose lattice of the specimen's
-  aspect ratio, walls closing in at a uniform strain rate to e = 0.31, then
-  isotropic consolidation by four servo walls at the confining stress with the
-  friction at 1.0, lowered step by step (x 0.7 each time) under the same stress
-  until the void ratio is at most 0.25 + 0.002, then restored to 0.5. The size of
-  the specimen follows from its discs and void ratio: about 180 x 305 mm (the
-  paper: 180 x 306.7 mm), see the summary.
+- Specimen preparation (``--preparation layers``, the default): multi-layer
+  under-compaction (the paper's ref. 58, Jiang, Konrad & Leroueil 2003;
+  ``cases._specimen.prepare_layers``). Five layers of discs, each a size-stratified
+  random fifth of the grading, are added one at a time on a loose lattice between
+  side walls 180 mm apart and pressed by the top wall (no gravity) to
+  h_i = (1 + e)[A_1 + ... + A_(i-1) + (1 + U_i) A_i]/W, with U_i falling linearly
+  from U_1 = 0.2 to 0 at the last layer, which closes the specimen at e = 0.25
+  exactly. That one specimen is then consolidated by four servo walls to 100, 200 or
+  400 kPa with the material's friction, so that every test starts from the same
+  fabric (the paper). Two numbers the paper leaves open, decided before the runs:
+  U_1, by the method's own aim, the most homogeneous specimen (standard deviation of
+  the void ratios of five equal bands, 1008 discs, compaction friction 0.5: 0.027,
+  0.015, 0.009, 0.015 for U_1 = 0, 0.1, 0.2, 0.3); and the friction while the layers
+  are pressed, lowered from the material's 0.5 by factors of 0.7 until the specimen,
+  consolidated to 200 kPa, is within 0.005 of the paper's e = 0.25: with 0.5 the
+  layers reach e = 0.25 only under about 0.9 MPa and the specimen swells to e = 0.261
+  at 200 kPa, with 0.35 to 0.256, with 0.245 (the value used) to about 0.249. The
+  quick preset's peak/residual phi at 200 kPa with each (no rolling resistance;
+  Model 1, delta 0.4; Model 2, delta 0.4; Model 1, delta 1.6), the sensitivity to
+  this decision:
+
+  ======================  =======  ===========  ===========  ===========  ===========
+  preparation             e        none         M1 0.4       M2 0.4       M1 1.6
+  ======================  =======  ===========  ===========  ===========  ===========
+  layers, friction 0.5    0.261    23.3/19.6    25.2/22.3    22.4/19.2    34.0/31.4
+  layers, friction 0.35   0.256    21.8/19.2    26.6/25.4    22.3/20.6    38.8/34.6
+  layers, friction 0.25   0.249    23.7/20.0    29.8/23.3    24.4/22.1    37.5/29.9
+  friction (below)        0.251    24.1/20.4    30.5/24.9    28.5/21.9    see docs
+  ======================  =======  ===========  ===========  ===========  ===========
+
+  ``--preparation friction`` is the earlier reading (``cases._specimen.prepare``):
+  discs on a loose lattice of the specimen's aspect ratio, walls closing in at a
+  uniform strain rate to e = 0.31, then isotropic consolidation by four servo walls
+  at the confining stress with the friction at 1.0, lowered step by step (x 0.7 each
+  time) under the same stress until the void ratio is at most 0.25 + 0.002, then
+  restored to 0.5: a specimen made for each stress. The size of the specimen
+  follows from its discs and void ratio: about 180 x 307 mm (the paper:
+  180 x 306.7 mm), see the summary.
 - Grading: piecewise linear by area through d10, d50 = 7.6 mm and d60 = 1.3 d10
   (``cases._specimen.gradation``); the paper's Fig. 9 curve itself is not given.
 - Density 2650 kg/m³ (not given), no gravity, local damping 0.7 (the paper's
@@ -99,6 +129,11 @@ from cases import _common as common
 CASE = "biaxial"
 
 CONFINING = (100e3, 200e3, 400e3)
+#: multi-layer under-compaction (module docstring): layers and the first layer's
+#: under-compaction ratio U_1
+LAYERS = {"layers": 5, "undercompaction": 0.2}
+#: friction while the layers are compacted (module docstring)
+COMPACTION_FRICTION = 0.245
 #: peak/residual phi (degrees) from the paper's text: (model, delta) -> (peak, residual)
 TARGETS = {
     (0, 0.0): (24.4, 19.3),
@@ -162,24 +197,56 @@ def check_material(model, delta):
 
 
 _SPECIMENS = {}     # this process's prepared specimens: key -> checkpoint bytes
+_LAYERED = {}       # this process's layered specimens before consolidation: key -> bytes
+#: how a specimen is made (``task["preparation"]``): "layers", multi-layer
+#: under-compaction to e = 0.25, then consolidation (the paper); "friction", consolidation
+#: at each stress with the friction lowered until e = 0.25 (the earlier reading)
+PREPARATIONS = ("layers", "friction")
 
 
 def specimen_key(task):
-    """What a specimen depends on: (n, confining stress, seed)."""
-    return (int(task["n"]), float(task["confining"]), int(task.get("seed", SEED)))
+    """What a specimen depends on: (n, confining stress, seed, preparation, friction of
+    the layers' compaction or None for the material's)."""
+    from tdem.errors import InputError
+    prep = task.get("preparation", "layers")
+    if prep not in PREPARATIONS:
+        raise InputError(f"preparation must be one of {PREPARATIONS}, got {prep!r}")
+    mu_c = task.get("compaction_friction", COMPACTION_FRICTION)
+    mu_c = COMPACTION_FRICTION if mu_c is None else mu_c
+    return (int(task["n"]), float(task["confining"]), int(task.get("seed", SEED)), prep,
+            None if mu_c is None else float(mu_c))
 
 
-def prepare_specimen(task):
-    """Prepare the specimen of ``task`` (a dict: n, confining, seed, threads, arch) and
-    return its checkpoint (:meth:`cases._specimen.Specimen.save`) as bytes."""
-    from cases import _specimen as specimen
-    n, confining, seed = specimen_key(task)
-    spec = specimen.prepare(n=n, confining=confining, seed=seed, density=DENSITY,
-                            threads=task.get("threads"), arch=task.get("arch"))
+def _to_bytes(spec):
     with tempfile.TemporaryDirectory(prefix="biaxial_") as tmp:
         path = Path(tmp) / "specimen.h5"
         spec.save(path)
         return path.read_bytes()
+
+
+def prepare_specimen(task):
+    """Prepare the specimen of ``task`` (a dict: n, confining, seed, preparation,
+    threads, arch) and return its checkpoint (:meth:`cases._specimen.Specimen.save`)
+    as bytes. "layers": one layered specimen per (n, seed) in this process, a copy of
+    it consolidated to the task's stress."""
+    from cases import _specimen as specimen
+    n, confining, seed, prep, mu_c = specimen_key(task)
+    threads, arch = task.get("threads"), task.get("arch")
+    if prep == "friction":
+        spec = specimen.prepare(n=n, confining=confining, seed=seed, density=DENSITY,
+                                threads=threads, arch=arch)
+        return _to_bytes(spec)
+    if (n, seed, mu_c) not in _LAYERED:
+        _LAYERED[(n, seed, mu_c)] = _to_bytes(specimen.prepare_layers(
+            n=n, seed=seed, density=DENSITY, compaction_friction=mu_c, threads=threads,
+            arch=arch, **LAYERS))
+    spec = load_specimen(_LAYERED[(n, seed, mu_c)], arch=arch)
+    spec.history["void_ratio_layered"] = spec.void_ratio()
+    spec.consolidate(confining, max_speed=0.5)
+    spec.history["void_ratio_consolidated"] = spec.void_ratio()
+    spec.history["band_void_ratio_consolidated"] = spec.band_void_ratios(
+        LAYERS["layers"]).tolist()
+    return _to_bytes(spec)
 
 
 def load_specimen(data, arch=None, keep=None):
@@ -297,13 +364,14 @@ def run_task(task):
     return shear_task(task, _SPECIMENS[key])
 
 
-def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None):
+def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None, preparation="layers"):
     """The tasks of a sweep: every material of ``cfg`` at every confining stress; the
     strain rate of ``cfg`` is the one at 200 kPa (:func:`strain_rate_at`)."""
     materials = cfg["materials"] if materials is None else materials
     return [{"n": cfg["n"], "confining": float(s), "model": int(m), "delta": float(d),
              "strain_rate": strain_rate_at(cfg["strain_rate"], float(s)),
-             "axial_strain": cfg["axial_strain"], "seed": cfg.get("seed", SEED), "arch": arch}
+             "axial_strain": cfg["axial_strain"], "seed": cfg.get("seed", SEED), "arch": arch,
+             "preparation": preparation}
             for s in confining for (m, d) in materials]
 
 
@@ -635,6 +703,13 @@ def _extra(p):
                    help="rolling model of that test: 1 (default with --delta) or 2; 0 = none")
     p.add_argument("--confining", type=float, default=200e3,
                    help="confining stress sigma_h in Pa (default 200e3)")
+    p.add_argument("--preparation", default="layers", choices=PREPARATIONS,
+                   help="layers: multi-layer under-compaction to e = 0.25, then "
+                        "consolidation (the paper, default); friction: consolidation at "
+                        "each stress with the friction lowered until e = 0.25")
+    p.add_argument("--compaction-friction", type=float, default=None,
+                   help="with --preparation layers: inter-particle friction while the "
+                        f"layers are compacted (default {COMPACTION_FRICTION})")
     p.add_argument("--sweep", action="store_true",
                    help="run the delta-phi study on Dask (Figs. 12-13)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -676,7 +751,7 @@ def _main_sweep(args, out, cfg, clock):
     sweep = dict(cfg["sweep"])
     if args.all_deltas:
         sweep["materials"] = PRESETS["paper"]["sweep"]["materials"]
-    tasks = sweep_tasks(sweep, arch=args.arch)
+    tasks = sweep_tasks(sweep, arch=args.arch, preparation=args.preparation)
     print(f"biaxial sweep ({args.preset}"
           f"{', all deltas' if args.all_deltas else ''}): {len(tasks)} tasks on "
           f"{args.scheduler or f'a local cluster of {args.workers} workers'}", flush=True)
@@ -765,7 +840,8 @@ def main(argv=None):
         tests = list(cfg["tests"])
         envelope_confining = cfg["envelope_confining"]
     base = {"n": cfg["n"], "axial_strain": cfg["axial_strain"], "seed": SEED,
-            "threads": args.threads, "arch": args.arch}
+            "threads": args.threads, "arch": args.arch, "preparation": args.preparation,
+            "compaction_friction": args.compaction_friction}
     results = []
     specimen_dir = out / "specimens"
     rate = strain_rate_at(cfg["strain_rate"], args.confining)
@@ -819,7 +895,11 @@ def main(argv=None):
     checks += [
         common.check("void_ratio", before["void_ratio"], 0.25, common.absolute(0.005), "",
                      "planar void ratio of the specimen under σ_h before compression "
-                     "(preparation stops within 0.002 of it)"),
+                     + ("(made at 0.25 exactly by the layers' compaction, under about "
+                        f"{max(spec0.history['layer_stress']) / 1e3:.0f} kPa with friction "
+                        f"{spec0.history['compaction_friction']:g}; it swells as it is "
+                        "unloaded to σ_h)" if "layer_stress" in spec0.history else
+                        "(preparation stops within 0.002 of it)")),
         common.check("sigma_h_hold", max(r["hold"] for r in results), None,
                      common.between(max=0.02), "",
                      "largest deviation of σ_h from its target, averaged over 0.5 % axial "
@@ -851,6 +931,10 @@ def main(argv=None):
         "parameters": {
             "n": cfg["n"], "kn": 2e8, "ks": 1.5e8, "friction": 0.5, "density": DENSITY,
             "wall_friction": 0.0, "local_damping": 0.7, "strain_rate": rate,
+            "preparation": args.preparation,
+            "layers": LAYERS if args.preparation == "layers" else None,
+            "compaction_friction": (None if args.preparation != "layers" else
+                                    spec0.history.get("compaction_friction")),
             "strain_rate_at_200kPa": cfg["strain_rate"], "axial_strain": cfg["axial_strain"],
             "dt": spec0.sim.dt,
             "inertial_number": rate * d50 * math.sqrt(DENSITY / args.confining),

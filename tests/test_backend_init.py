@@ -20,6 +20,7 @@ def _child(code, **env):
     e.pop("TDEM_ARCH", None)
     e.pop("TDEM_THREADS", None)
     e.pop("TDEM_CFG_OPTIMIZATION", None)
+    e.pop("TDEM_OPT_LEVEL", None)
     e.update(env)
     return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, env=e,
                           capture_output=True, text=True, timeout=120)
@@ -98,11 +99,25 @@ def test_control_flow_optimisation_off_unless_asked(env, expected):
     assert f"CFG {expected}" in r.stdout
 
 
+@pytest.mark.parametrize("env, expected", [(None, "1"), ("0", "0"), ("1", "1")])
+def test_optimisation_level_from_the_environment(env, expected):
+    # Taichi's own default (1) unless $TDEM_OPT_LEVEL asks for 0 (faster builds)
+    r = _child("""
+        import taichi as ti
+        import tdem
+        tdem.Simulation()
+        print("OPT", ti.lang.impl.current_cfg().opt_level)
+        """, **({} if env is None else {"TDEM_OPT_LEVEL": env}))
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert f"OPT {expected}" in r.stdout
+
+
 @pytest.mark.parametrize("name, value, message", [
     ("TDEM_THREADS", "many", "TDEM_THREADS must be a whole number >= 1, got 'many'"),
     ("TDEM_CFG_OPTIMIZATION", "yes", "TDEM_CFG_OPTIMIZATION must be 0 or 1, got 'yes'"),
     ("TDEM_ADVANCED_OPTIMIZATION", "on",
-     "TDEM_ADVANCED_OPTIMIZATION must be 0 or 1, got 'on'")])
+     "TDEM_ADVANCED_OPTIMIZATION must be 0 or 1, got 'on'"),
+    ("TDEM_OPT_LEVEL", "2", "TDEM_OPT_LEVEL must be 0 or 1, got '2'")])
 def test_bad_environment_settings_are_named(name, value, message):
     r = _child("""
         import tdem

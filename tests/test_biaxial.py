@@ -132,13 +132,14 @@ def test_phi_table_means_ranges_and_the_papers_values():
 
 
 # ------------------------------------------------------------------ the sweep
+# (the sweep's machinery, on the quicker of the two preparations)
 TINY = {"n": 120, "strain_rate": 2.0, "axial_strain": 0.03, "seed": 5}
 
 
 def test_dask_sweep_equals_serial_runs():
     pytest.importorskip("distributed", reason='Dask is an extra: pip install "tdem[sweep]"')
     tasks = biaxial.sweep_tasks(dict(TINY, materials=[(0, 0.0), (1, 0.4)]),
-                                confining=(SIGMA,))
+                                confining=(SIGMA,), preparation="friction")
     assert len(tasks) == 2
     swept = biaxial.run_sweep(tasks, workers=2)
     # the same tasks one after the other, in one fresh process
@@ -212,7 +213,7 @@ def test_sweep_keeps_each_test_and_goes_on_after_an_interruption(tmp_path):
     and runs the others, with the same numbers as a run without interruption."""
     pytest.importorskip("distributed", reason='Dask is an extra: pip install "tdem[sweep]"')
     tasks = biaxial.sweep_tasks(dict(TINY, materials=[(0, 0.0), (1, 0.4)]),
-                                confining=(SIGMA,))
+                                confining=(SIGMA,), preparation="friction")
     keep = tmp_path / "tests"
     first = biaxial.run_sweep(tasks, workers=2, keep=keep)
     files = [biaxial.result_file(keep, t) for t in tasks]
@@ -234,3 +235,72 @@ def test_sweep_keeps_each_test_and_goes_on_after_an_interruption(tmp_path):
     assert again[1]["wall_s"] > 0.0 and files[1].exists()
     assert again[1]["phi"] == first[1]["phi"]          # run again: the same numbers
     np.testing.assert_array_equal(again[1]["curves"]["sigma_v"], first[1]["curves"]["sigma_v"])
+
+
+# ------------------------------------------------------------------ layered preparation
+def test_layer_heights_follow_the_undercompaction_criterion():
+    """h_i = (1 + e)[A_1 + ... + A_(i-1) + (1 + U_i) A_i]/W with U_i falling linearly
+    from U_1 to 0: the last layer closes the specimen at the target void ratio."""
+    areas = np.array([1.0, 1.2, 0.9, 1.1]) * 1e-3
+    h = specimen.layer_heights(areas, 0.2, 0.25, 0.15)
+    u = np.array([0.15, 0.10, 0.05, 0.0])
+    below = np.concatenate([[0.0], np.cumsum(areas)[:-1]])
+    np.testing.assert_allclose(h, 1.25 * (below + (1 + u) * areas) / 0.2, rtol=1e-14)
+    assert h[-1] * 0.2 / areas.sum() - 1.0 == pytest.approx(0.25, rel=1e-14)
+    assert np.all(np.diff(h) > 0)
+
+
+@pytest.fixture(scope="module")
+def layered():
+    return specimen.prepare_layers(n=240, layers=4, seed=2, undercompaction=0.2, speed=1.0,
+                                   check_every=50,
+                                   compaction_friction=biaxial.COMPACTION_FRICTION)
+
+
+def test_layered_specimen_is_made_at_its_void_ratio_and_is_homogeneous(layered):
+    spec = layered
+    e = spec.void_ratio()
+    print(f"layers: heights {spec.history['layer_height']}, stresses "
+          f"{spec.history['layer_stress']}, band void ratios {spec.history['band_void_ratio']}")
+    assert e == pytest.approx(0.25, abs=1e-6)
+    assert spec.width == pytest.approx(0.18, rel=1e-12)
+    # every disc inside the box, and the material's friction throughout
+    p = spec.sim.particles.numpy()
+    x, r = p["position"], p["radius"]
+    x0, x1, y0, y1 = spec.box()
+    # (wall overlaps under the compaction stress are a few per cent of a radius)
+    out = np.max([x0 - (x[:, 0] - r), x[:, 0] + r - x1, y0 - (x[:, 1] - r),
+                  x[:, 1] + r - y1], axis=0) / r
+    print(f"largest wall overlap {out.max():.3f} radii")
+    assert out.max() < 0.1
+    assert spec.law.friction == 0.5 and spec.history["compaction_friction"] == 0.245
+    # the bands' void ratios, from the exact disc areas inside them, average to e
+    # (less what the discs' overlaps with the walls put outside the box)
+    bands = np.array(spec.history["band_void_ratio"])
+    solid = 1.0 / (1.0 + bands)
+    assert np.mean(solid) == pytest.approx(1.0 / (1.0 + e), rel=1e-3)
+    assert np.all(np.abs(bands - 0.25) < 0.08)     # (layers under two rows thick here)
+
+
+def test_layered_specimen_consolidates_denser_at_a_higher_stress(layered, tmp_path):
+    """One layered specimen brought to 100 and to 400 kPa: both at rest under their
+    stress, the second denser (the same fabric, pressed harder)."""
+    path = tmp_path / "layered.h5"
+    layered.save(path)
+    e = {}
+    for s in (100e3, 400e3):
+        spec = specimen.Specimen.load(path)
+        spec.consolidate(s, max_speed=0.5)
+        sh, sv = spec.stresses()
+        assert abs(sh / s - 1.0) < 0.05 and abs(sv / s - 1.0) < 0.05
+        e[s] = spec.void_ratio()
+    print(f"void ratio {e[100e3]:.4f} at 100 kPa, {e[400e3]:.4f} at 400 kPa")
+    assert e[400e3] < e[100e3]
+    assert abs(e[100e3] - 0.25) < 0.03
+
+
+def test_preparation_is_checked():
+    with pytest.raises(tdem.InputError, match="preparation"):
+        biaxial.specimen_key({"n": 10, "confining": 1e5, "preparation": "vibration"})
+    with pytest.raises(tdem.InputError, match="layers"):
+        specimen.prepare_layers(n=20, layers=0)
