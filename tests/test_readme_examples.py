@@ -40,7 +40,7 @@ def test_readme_example_runs(k, tmp_path):
         import math
 
         import tdem
-        n = len(tdem.pack.lattice3d((0, 0, 0), (0.1, 0.1, 0.2), 0.0051, kind="cubic"))
+        n = len(tdem.pack.lattice3d((0, 0, 0), (0.1, 0.1, 0.1), 0.0051, kind="cubic"))
         weight = n * 2500 * 4.0 / 3.0 * math.pi * 0.005 * 0.004 * 0.003 * 9.81
         num = r"\s*(-?[0-9.]+(?:e[+-]?[0-9]+)?)"
         fz = float(re.search(r"\[" + num * 3 + r"\s*\]", out.stdout).group(3))
