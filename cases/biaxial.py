@@ -367,15 +367,84 @@ def run_task(task):
     return shear_task(task, _SPECIMENS[key])
 
 
-def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None, preparation="layers"):
-    """The tasks of a sweep: every material of ``cfg`` at every confining stress; the
-    strain rate of ``cfg`` is the one at 200 kPa (:func:`strain_rate_at`)."""
+def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None, preparation="layers",
+                seeds=None, rates=None):
+    """The tasks of a sweep: every material of ``cfg`` at every confining stress, for
+    every specimen seed (``seeds``, default ``cfg``'s seed) and strain rate at 200 kPa
+    (``rates``, default ``cfg``'s; at other stresses :func:`strain_rate_at`)."""
+    from tdem.errors import InputError
     materials = cfg["materials"] if materials is None else materials
+    seeds = [cfg.get("seed", SEED)] if seeds is None else list(seeds)
+    rates = [cfg["strain_rate"]] if rates is None else list(rates)
+    for r in rates:
+        if not (isinstance(r, (int, float)) and math.isfinite(r) and r > 0):
+            raise InputError(f"strain rates must be positive numbers (1/s), got {r!r}")
+    for sd in seeds:
+        if isinstance(sd, bool) or not isinstance(sd, (int, np.integer)) or sd < 0:
+            raise InputError(f"seeds must be whole numbers >= 0, got {sd!r}")
+    for sg in confining:
+        if not (isinstance(sg, (int, float)) and math.isfinite(sg) and sg > 0):
+            raise InputError(f"confining stresses must be positive (Pa), got {sg!r}")
     return [{"n": cfg["n"], "confining": float(s), "model": int(m), "delta": float(d),
-             "strain_rate": strain_rate_at(cfg["strain_rate"], float(s)),
-             "axial_strain": cfg["axial_strain"], "seed": cfg.get("seed", SEED), "arch": arch,
+             "strain_rate": strain_rate_at(float(rate), float(s)),
+             "axial_strain": cfg["axial_strain"], "seed": int(seed), "arch": arch,
              "preparation": preparation}
-            for s in confining for (m, d) in materials]
+            for seed in seeds for rate in rates for s in confining for (m, d) in materials]
+
+
+def rate_at_200kpa(task):
+    """The strain rate of ``task`` at 200 kPa (the sweep's rate, :func:`strain_rate_at`)."""
+    return task["strain_rate"] / math.sqrt(task["confining"] / 200e3)
+
+
+def spread_table(results):
+    """Markdown tables of a sweep over several specimens (seeds) or rates: per
+    material, strain rate (at 200 kPa) and confining stress, the peak and residual φ
+    as mean ± standard deviation (min–max) over the seeds; then per material and rate,
+    the slopes of the peak and residual envelopes fitted to each seed's tests, the
+    same way, beside the paper's values."""
+    def stat(v):
+        v = np.asarray(v, float)
+        sd = f" ± {v.std(ddof=1):.1f}" if len(v) > 1 else ""
+        return f"{v.mean():.1f}°{sd} ({v.min():.1f}–{v.max():.1f}, {len(v)})"
+
+    def paper(name, col):
+        for (m, d), t in TARGETS.items():
+            if material_name(m, d) == name:
+                return f"{t[col]:.1f}°"
+        return "–"
+
+    groups = {}
+    for r in results:
+        key = (r["name"], round(rate_at_200kpa(r["task"]), 9), r["task"]["confining"])
+        groups.setdefault(key, []).append(r)
+    rows = ["| material | rate at 200 kPa (1/s) | σ_h (kPa) | peak φ | residual φ | "
+            "paper peak / residual |", "| --- | --- | --- | --- | --- | --- |"]
+    for (name, rate, sg), rs in sorted(groups.items()):
+        rows.append(f"| {name} | {rate:g} | {sg / 1e3:g} | "
+                    f"{stat([r['phi']['phi_peak'] for r in rs])} | "
+                    f"{stat([r['phi']['phi_residual'] for r in rs])} | "
+                    f"{paper(name, 0)} / {paper(name, 1)} |")
+    per_seed = {}
+    for r in results:
+        key = (r["name"], round(rate_at_200kpa(r["task"]), 9))
+        per_seed.setdefault(key, {}).setdefault(r["task"].get("seed", SEED), []).append(r)
+    slopes = ["| material | rate at 200 kPa (1/s) | peak envelope slope | residual envelope "
+              "slope | paper peak / residual |", "| --- | --- | --- | --- | --- |"]
+    for (name, rate), by_seed in sorted(per_seed.items()):
+        env = [envelopes(rs)[name] for rs in by_seed.values()
+               if len({r["task"]["confining"] for r in rs}) > 1]
+        if not env:
+            continue
+        slopes.append(f"| {name} | {rate:g} | {stat([e['peak']['phi'] for e in env])} | "
+                      f"{stat([e['residual']['phi'] for e in env])} | "
+                      f"{paper(name, 0)} / {paper(name, 1)} |")
+    out = ("φ per test, mean ± standard deviation over the specimens (seeds), range and "
+           "count:\n\n" + "\n".join(rows) + "\n")
+    if len(slopes) > 2:
+        out += ("\nSlopes of the envelopes (Fig. 12) fitted to each specimen's tests at the "
+                "confining stresses, over the specimens:\n\n" + "\n".join(slopes) + "\n")
+    return out
 
 
 def result_file(folder, task):
@@ -454,7 +523,8 @@ def envelope(points):
     p = np.array([x[0] for x in points], dtype=float)
     q = np.array([x[1] for x in points], dtype=float)
     origin = math.degrees(math.asin(min(1.0, float(np.sum(p * q) / np.sum(p * p)))))
-    if len(p) < 2:
+    if len(p) < 2 or np.ptp(p) < 0.2 * np.mean(p):
+        # one confining stress (several specimens): no slope to fit
         return {"phi": origin, "cohesion": 0.0, "phi_through_origin": origin}
     b, a = np.polyfit(p, q, 1)
     phi = math.degrees(math.asin(float(np.clip(b, -1.0, 1.0))))
@@ -722,6 +792,17 @@ def _extra(p):
     p.add_argument("--all-deltas", action="store_true",
                    help="with --sweep: the paper's 33 materials (delta = 0, 0.1 ... 1.6, "
                         "Models 1 and 2) at this preset's strain rate and strain")
+    p.add_argument("--four-tests", action="store_true",
+                   help="with --sweep: the preset's four materials (none; Model 1, delta "
+                        "0.4; Model 2, delta 0.4; Model 1, delta 1.6) instead of its sweep's")
+    p.add_argument("--seeds", type=int, nargs="+", default=None, metavar="SEED",
+                   help="with --sweep: specimens made with these seeds (default: one, "
+                        f"seed {SEED}); the spread over them in sweep.md")
+    p.add_argument("--rates", type=float, nargs="+", default=None, metavar="RATE",
+                   help="with --sweep: strain rates at 200 kPa in 1/s (default: the "
+                        "preset's); the convergence with the rate in sweep.md")
+    p.add_argument("--stresses", type=float, nargs="+", default=None, metavar="PA",
+                   help="with --sweep: confining stresses in Pa (default 100e3 200e3 400e3)")
 
 
 def phi_table(tests):
@@ -752,9 +833,16 @@ def _main_sweep(args, out, cfg, clock):
     if args.workers < 1:
         raise InputError(f"workers must be >= 1, got {args.workers!r}")
     sweep = dict(cfg["sweep"])
+    if args.all_deltas and args.four_tests:
+        raise InputError("all_deltas and four_tests: choose one")
     if args.all_deltas:
         sweep["materials"] = PRESETS["paper"]["sweep"]["materials"]
-    tasks = sweep_tasks(sweep, arch=args.arch, preparation=args.preparation)
+    if args.four_tests:
+        sweep["materials"] = list(cfg["tests"])
+        sweep["axial_strain"] = cfg["axial_strain"]
+    tasks = sweep_tasks(sweep, arch=args.arch, preparation=args.preparation, seeds=args.seeds,
+                        rates=args.rates,
+                        confining=CONFINING if args.stresses is None else args.stresses)
     print(f"biaxial sweep ({args.preset}"
           f"{', all deltas' if args.all_deltas else ''}): {len(tasks)} tasks on "
           f"{args.scheduler or f'a local cluster of {args.workers} workers'}", flush=True)
@@ -767,7 +855,9 @@ def _main_sweep(args, out, cfg, clock):
     (out / "sweep.md").write_text(
         f"φ against δ, {len(results)} tests ({args.preset} preset's rate and strain; "
         "mean and range over the confining stresses):\n\n" + phi_table(
-            [{"task": r["task"], "phi": r["phi"]} for r in results]))
+            [{"task": r["task"], "phi": r["phi"]} for r in results])
+        + ("\n" + spread_table(results) if len({r["task"]["seed"] for r in results}) > 1
+           or len({round(rate_at_200kpa(r["task"]), 9) for r in results}) > 1 else ""))
     checks = []
     for (model, delta), (pk, rs) in TARGETS.items():
         name = material_name(model, delta)
@@ -823,8 +913,9 @@ def main(argv=None):
     cfg = PRESETS[args.preset]
     if not (args.confining > 0 and math.isfinite(args.confining)):
         raise InputError(f"confining must be a positive stress in Pa, got {args.confining!r}")
-    if args.all_deltas and not args.sweep:
-        raise InputError("all_deltas: only with --sweep")
+    for flag in ("all_deltas", "four_tests", "seeds", "rates", "stresses"):
+        if getattr(args, flag) not in (None, False) and not args.sweep:
+            raise InputError(f"{flag}: only with --sweep")
     if args.sweep:
         try:
             common.dask_distributed()

@@ -304,3 +304,48 @@ def test_preparation_is_checked():
         biaxial.specimen_key({"n": 10, "confining": 1e5, "preparation": "vibration"})
     with pytest.raises(tdem.InputError, match="layers"):
         specimen.prepare_layers(n=20, layers=0)
+
+
+def test_sweep_over_seeds_and_rates():
+    cfg = dict(TINY, materials=[(0, 0.0), (1, 0.4)])
+    tasks = biaxial.sweep_tasks(cfg, confining=(100e3, 400e3), seeds=(0, 1, 2),
+                                rates=(1.0, 0.25))
+    assert len(tasks) == 3 * 2 * 2 * 2
+    assert sorted({t["seed"] for t in tasks}) == [0, 1, 2]
+    at = {(t["strain_rate"], t["confining"]) for t in tasks}
+    # the inertial number of the rate at 200 kPa kept: rate ∝ sqrt(σ)
+    assert at == {(1.0 * math.sqrt(0.5), 100e3), (1.0 * math.sqrt(2.0), 400e3),
+                  (0.25 * math.sqrt(0.5), 100e3), (0.25 * math.sqrt(2.0), 400e3)}
+    assert {round(biaxial.rate_at_200kpa(t), 12) for t in tasks} == {1.0, 0.25}
+    for bad, match in (({"rates": (0.0,)}, "strain rates"), ({"seeds": (-1,)}, "seeds"),
+                       ({"seeds": (1.5,)}, "seeds"), ({"confining": (float("nan"),)},
+                                                      "confining")):
+        with pytest.raises(tdem.InputError, match=match):
+            biaxial.sweep_tasks(cfg, **bad)
+    with pytest.raises(tdem.InputError, match="seeds: only with --sweep"):
+        biaxial.main(["--seeds", "1", "2"])
+
+
+def test_spread_table_means_deviations_and_envelope_slopes():
+    """sweep.md over several specimens: φ as mean ± standard deviation (range, count)
+    over the seeds; each seed's envelope slope fitted to its own tests."""
+    def r(seed, s, pk, rs, rate=0.1):
+        # a test whose peak and residual stresses give exactly these angles
+        out = {"task": {"model": 0, "delta": 0.0, "confining": s, "seed": seed,
+                        "strain_rate": rate * math.sqrt(s / 200e3)}, "name": "none", "phi": {}}
+        for key, phi in (("peak", pk), ("residual", rs)):
+            k = math.sin(math.radians(phi))
+            sv = s * (1 + k) / (1 - k)
+            out["phi"].update({f"phi_{key}": phi})
+            if key == "peak":
+                out["phi"].update(sigma_v_peak=sv, sigma_h_at_peak=s)
+            else:
+                out["phi"].update(sigma_v_residual=sv, sigma_h_residual=s)
+        return out
+    res = [r(0, 100e3, 22.0, 18.0), r(0, 400e3, 22.0, 18.0),
+           r(1, 100e3, 24.0, 20.0), r(1, 400e3, 24.0, 20.0)]
+    text = biaxial.spread_table(res)
+    assert "| none | 0.1 | 100 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) | " \
+           "24.4° / 19.3° |" in text
+    # each seed's envelope passes through the origin at its own angle: slopes 22 and 24
+    assert "| none | 0.1 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) |" in text
