@@ -392,6 +392,17 @@ def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None, preparation
             for seed in seeds for rate in rates for s in confining for (m, d) in materials]
 
 
+def parse_material(text):
+    """'MODEL:DELTA' (as ``--materials`` takes it) -> (model, delta), checked."""
+    from tdem.errors import InputError
+    try:
+        model, delta = text.split(":")
+        model, delta = int(model), float(delta)
+    except ValueError:
+        raise InputError(f"materials must be MODEL:DELTA, e.g. 1:0.4, got {text!r}") from None
+    return check_material(model, delta)
+
+
 def rate_at_200kpa(task):
     """The strain rate of ``task`` at 200 kPa (the sweep's rate, :func:`strain_rate_at`)."""
     return task["strain_rate"] / math.sqrt(task["confining"] / 200e3)
@@ -453,7 +464,9 @@ def result_file(folder, task):
     model, delta = check_material(task["model"], task["delta"])
     return Path(folder) / (f"sigma{task['confining'] / 1e3:g}kPa_{material_name(model, delta)}"
                            f"_rate{task['strain_rate']:.6g}_strain{task['axial_strain']:g}"
-                           f"_n{task['n']}_seed{task.get('seed', SEED)}.h5")
+                           f"_n{task['n']}_seed{task.get('seed', SEED)}"
+                           + ("" if task.get("preparation", "layers") == "layers" else
+                              f"_{task['preparation']}") + ".h5")
 
 
 def run_sweep(tasks, scheduler=None, workers=2, keep=None):
@@ -795,6 +808,9 @@ def _extra(p):
     p.add_argument("--four-tests", action="store_true",
                    help="with --sweep: the preset's four materials (none; Model 1, delta "
                         "0.4; Model 2, delta 0.4; Model 1, delta 1.6) instead of its sweep's")
+    p.add_argument("--materials", nargs="+", default=None, metavar="MODEL:DELTA",
+                   help="with --sweep: these materials, e.g. 0:0 1:0.4 2:0.4 (model 0 or "
+                        "delta 0: no rolling resistance)")
     p.add_argument("--seeds", type=int, nargs="+", default=None, metavar="SEED",
                    help="with --sweep: specimens made with these seeds (default: one, "
                         f"seed {SEED}); the spread over them in sweep.md")
@@ -833,12 +849,15 @@ def _main_sweep(args, out, cfg, clock):
     if args.workers < 1:
         raise InputError(f"workers must be >= 1, got {args.workers!r}")
     sweep = dict(cfg["sweep"])
-    if args.all_deltas and args.four_tests:
-        raise InputError("all_deltas and four_tests: choose one")
     if args.all_deltas:
         sweep["materials"] = PRESETS["paper"]["sweep"]["materials"]
+    if sum(map(bool, (args.all_deltas, args.four_tests, args.materials))) > 1:
+        raise InputError("all_deltas, four_tests and materials: choose one")
     if args.four_tests:
         sweep["materials"] = list(cfg["tests"])
+        sweep["axial_strain"] = cfg["axial_strain"]
+    if args.materials:
+        sweep["materials"] = [parse_material(m) for m in args.materials]
         sweep["axial_strain"] = cfg["axial_strain"]
     tasks = sweep_tasks(sweep, arch=args.arch, preparation=args.preparation, seeds=args.seeds,
                         rates=args.rates,
@@ -913,7 +932,7 @@ def main(argv=None):
     cfg = PRESETS[args.preset]
     if not (args.confining > 0 and math.isfinite(args.confining)):
         raise InputError(f"confining must be a positive stress in Pa, got {args.confining!r}")
-    for flag in ("all_deltas", "four_tests", "seeds", "rates", "stresses"):
+    for flag in ("all_deltas", "four_tests", "materials", "seeds", "rates", "stresses"):
         if getattr(args, flag) not in (None, False) and not args.sweep:
             raise InputError(f"{flag}: only with --sweep")
     if args.sweep:

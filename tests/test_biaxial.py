@@ -349,3 +349,14 @@ def test_spread_table_means_deviations_and_envelope_slopes():
            "24.4° / 19.3° |" in text
     # each seed's envelope passes through the origin at its own angle: slopes 22 and 24
     assert "| none | 0.1 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) |" in text
+
+
+def test_materials_of_a_sweep_are_parsed_and_checked():
+    assert biaxial.parse_material("1:0.4") == (1, 0.4)
+    assert biaxial.parse_material("0:0") == (0, 0.0)
+    with pytest.raises(tdem.InputError, match="MODEL:DELTA.*'1-0.4'"):
+        biaxial.parse_material("1-0.4")
+    with pytest.raises(tdem.InputError, match="model must be 0"):
+        biaxial.parse_material("3:0.4")
+    with pytest.raises(tdem.InputError, match="delta must be 0 without"):
+        biaxial.parse_material("0:0.4")
