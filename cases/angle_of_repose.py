@@ -1,6 +1,6 @@
 """Heaps of cubes beside heaps of spheres on a rough base: angle of repose and base pressure (Chen, polyhedral DEM).
 
-Chen's thesis (abstract, PHYSICS §9): heaps of convex polyhedra with the
+Chen's thesis (abstract): heaps of convex polyhedra with the
 overlap-volume contact stand at "more realistic, high angles of repose" on a flat
 base than any model with round particles; heaps built by wedge sequences show a
 pressure dip under the apex, heaps built by layered sequences a pressure maximum.

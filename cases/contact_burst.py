@@ -1,6 +1,6 @@
 """Contact burst of a TNT charge on soft rock (Feng, Li & Oñate 2015 §4.2, Figs. 21-24): crater, surface motion, pressure decay.
 
-Set-up (paper §4.2 and spec CASES.md)
+Set-up (paper §4.2)
 -------------------------------------
 Soft rock 8 m x 2 m, Mohr-Coulomb with tension cut-off (rho = 2500 kg/m3,
 E = 20 GPa, nu = 0.25, c = 0.1 MPa, T = 0.05 MPa, phi = 30 deg), PCMM particles on

@@ -52,7 +52,7 @@ the least-squares linear fit over the particles (PCMM; reference positions) or t
 element centroids / nodes (FVM) within about 1.5 spacings of it, exact for a linear
 field (random particles do not line up at x = 10 m, the paper's remark on Fig. 9).
 
-Targets (spec CASES.md): σ_yy at the monitors within 5 % of the exact plane-strain
+Targets (docs/cases.md): σ_yy at the monitors within 5 % of the exact plane-strain
 elastic solution of this fixed-base, free-sided square (``elastic_reference``, a
 converged FE solution computed here), away from the base (monitors y ≥ 4 m);
 vertical displacement profiles of the four models within 5 % of each other (here:
@@ -318,7 +318,7 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None):
                         "monitor_sigma_yy": m.mon_syy, **m.sim.histories()}
     notes = (
         "All models span 0-20 m (PCMM centres on the edges). sigma_yy is compared with "
-        "the plane-strain elastic solution of this fixed-base square (spec CASES.md); "
+        "the plane-strain elastic solution of this fixed-base square (docs/cases.md); "
         "that solution differs from the section average -rho g (20 - y) by up to "
         f"{data['elastic_reference']['sigma_yy_max_rel_error_away_from_base']:.1%} at "
         "x = 10 m (data.elastic_reference), which the summary keeps for information.")

@@ -1,6 +1,6 @@
 """Ellipsoids compressed by a rigid plate: contact forces on the plates (Miyata et al. 2002, §3.3, Figs. 32-37).
 
-Set-up (Miyata §3.3; CASES.md ``ellipsoid_compression``)
+Set-up (Miyata §3.3)
 --------------------------------------------------------
 Mono-size ellipsoids, semi-axes 0.371, 0.260 and 0.182 m (the rubble-rock ratios
 1 : 0.7 : 0.49), ρ = 2600 kg/m³ (191.2 kg each; the paper: about 191 kg), in a box

@@ -1,6 +1,6 @@
 """Plate loading of a granular bed: circles against superellipses (Miyata et al. 2002, §3.2, Figs. 26–30).
 
-Set-up (Miyata §3.2, Tables 1–2; CASES.md ``plate_loading``)
+Set-up (Miyata §3.2, Tables 1–2)
 -------------------------------------------------------------
 A 2D bed, 10 m wide with periodic sides, on a rigid floor, compressed by a rigid plate
 that moves down at 0.01 m/s until it carries 900 kPa. Four beds:

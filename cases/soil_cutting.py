@@ -1,6 +1,6 @@
 """Soil cutting by an inclined blade (Feng, Li & Oñate 2015 §4.1, Figs. 17-20): shear bands, surface heave, bulk stress.
 
-Set-up (paper §4.1 and spec CASES.md)
+Set-up (paper §4.1)
 -------------------------------------
 Soil 3 m x 1 m, Mohr-Coulomb with tension cut-off (rho = 1750 kg/m3, E = 10 MPa,
 nu = 0.35, c = 10 kPa, phi = 20 deg, T = 3 kPa), PCMM particles on a square lattice

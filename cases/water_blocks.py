@@ -1,6 +1,6 @@
 """Water released against stacked concrete blocks (Feng, Li & Oñate 2015 §4.3, Figs. 25-27; paper: four columns stand, two topple).
 
-Set-up (paper §4.3 and spec CASES.md)
+Set-up (paper §4.3)
 -------------------------------------
 Tank: a floor 3 m long (y = 0, x from 0 to 3 m) with vertical walls at both ends.
 Water 0.8 m wide and 1.4 m high against the left wall, held by a board at
@@ -40,7 +40,7 @@ Presets
 - ``quick``: water on a square lattice R = 2 cm (20 × 35 = 700 particles),
   δ = R, K = 15 MPa (weakly compressible: c = 122 m/s, ten times the fastest
   water particle of the run, 12 m/s in the jets at the blocks; the dam-break
-  front moves at about 2·sqrt(g·H) = 7.4 m/s; spec §3; with K = 6 MPa,
+  front moves at about 2·sqrt(g·H) = 7.4 m/s; with K = 6 MPa,
   c = 77 m/s, the outcome was the same), 1.2 s after the lift.
 - ``paper``: the paper's particle count on a square lattice, R = 7.1 mm
   (56 × 98 = 5488 particles; the paper: 5528 random discs of R = 3-8 mm),
@@ -499,7 +499,8 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
                 f"{name}.water_vmax", float(np.max(r["vmax_water"])) if len(r["vmax_water"])
                 else None, None, common.between(max=c / 10.0), "m/s",
                 f"largest speed of a water particle in the tank; weakly compressible water "
-                f"needs c >= 10 x the largest flow speed (spec PHYSICS.md), c = {c:.0f} m/s"),
+                f"needs c >= 10 x the largest flow speed (weakly compressible water), "
+                f"c = {c:.0f} m/s"),
             common.check(
                 f"{name}.water_left_tank", int(np.max(r["outside"])) if len(r["outside"])
                 else None, 0, common.EQUAL, "",

@@ -1,4 +1,4 @@
-"""Deformable blocks: triangle meshes with fixed connectivity (spec §4).
+"""Deformable blocks: triangle meshes with fixed connectivity (the CDEM's blocks).
 
 A block is the element model the paper compares every PCMM model against: the
 same incremental FVM update as the PCMM elements (:mod:`physics.fvm`, Eqs. 6–14)

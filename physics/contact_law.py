@@ -493,8 +493,8 @@ def _turned(h, first: ti.template(), n):
 @ti.func
 def rotate_tangential(laws: ti.template(), lawp: ti.template(), L, h, n):
     """3D: the history ``h`` with each tangent-plane column of the law of row L turned
-    onto the plane normal to the current normal n, its magnitude kept (PHYSICS §8:
-    the contact plane turns between steps; LIGGGHTS and Yade do the same)."""
+    onto the plane normal to the current normal n, its magnitude kept
+    (the contact plane turns between steps; LIGGGHTS and Yade do the same)."""
     code = ti.cast(lawp[L, COL_CODE], ti.i32)
     for c in ti.static(range(len(laws))):
         if code == c:

@@ -310,7 +310,7 @@ class Fluid(Material):
     ----------
     density : ρ0 (kg/m³), > 0, the density at zero pressure
     bulk_modulus : K (Pa), > 0 (the paper: 2 GPa; a case may lower it to a weakly
-        compressible value, c = sqrt(K/ρ0) ≥ 10 × the largest flow speed, spec §3)
+        compressible value, c = sqrt(K/ρ0) ≥ 10 × the largest flow speed)
     viscosity : dynamic viscosity μ (Pa·s), ≥ 0: the stress 2μ·dev(D) on the
         element forces of each step (not accumulated)
     linear_viscosity, quadratic_viscosity : artificial bulk viscosity b1, b2 ≥ 0

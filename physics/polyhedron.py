@@ -1,4 +1,4 @@
-"""Convex polyhedra (PHYSICS §9, Chen's polyhedral DEM): the host-side description.
+"""Convex polyhedra (Chen's polyhedral DEM): the host-side description.
 
 :class:`Polyhedron` takes any points and keeps their convex hull (scipy's Qhull):
 
@@ -164,7 +164,7 @@ class Polyhedron:
 
     @property
     def length(self):
-        """Characteristic length l = V^(1/3) (m; PHYSICS §9)."""
+        """Characteristic length l = V^(1/3) (m; Chen's polyhedral DEM)."""
         return self.volume ** (1.0 / 3.0)
 
     @property

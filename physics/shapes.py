@@ -1,4 +1,4 @@
-"""Particle shapes other than the disc (PHYSICS §7): the host-side description.
+"""Particle shapes other than the disc (Miyata et al. 2002, §2.3): the host-side description.
 
 A shape is a frozen description in the body frame. The engine keeps, per particle,
 its parameters in the state array ``shp`` (a, b, n; n = 0 for a disc), its angle θ
@@ -16,7 +16,7 @@ Superellipse (Miyata et al. 2002, Eq. 34): |x/a|ⁿ + |y/b|ⁿ = 1, 2 ≤ n ≤ 
 - n = 2, a = b is a disc of radius a and gives the disc results;
 - the bounding radius (the neighbour grid's) is the largest distance of a boundary
   point from the centre: max(a, b) for n = 2 only — for n > 2 the corners reach
-  beyond it (PHYSICS §7 says max(a, b), which would miss contacts at the corners).
+  beyond it (Miyata et al. (2002) say max(a, b), which would miss contacts at the corners).
 """
 import math
 
@@ -230,7 +230,7 @@ class Ellipsoid:
     Volume 4/3 π abc; principal moments of inertia m/5 (b² + c², a² + c², a² + b²);
     support function h(u) = sqrt(uᵀ M u), M = R diag(a², b², c²) Rᵀ, support point
     x + M u/h(u); Gaussian curvature at the point of normal u h(u)⁴/(a²b²c²) (the
-    Hertz radius there is the geometric mean abc/h(u)², PHYSICS §8)."""
+    Hertz radius there is the geometric mean abc/h(u)², Miyata et al. 2002, §2.4)."""
 
     kind = "ellipsoid"
 

@@ -1,4 +1,4 @@
-"""Chen's overlap-volume contact for convex polyhedra (PHYSICS §9).
+"""Chen's overlap-volume contact for convex polyhedra (Chen's polyhedral DEM).
 
 Normal: F_n = E·V/l_c, V the volume of the overlap polyhedron of the two undeformed
 bodies and l_c = 2 l_i l_j/(l_i + l_j) their characteristic length (l = V_body^(1/3);

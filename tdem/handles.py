@@ -68,7 +68,7 @@ class ParticleGroup:
 
 
 class Block:
-    """A deformable block: a triangle mesh with fixed connectivity (spec §4), made by
+    """A deformable block: a triangle mesh with fixed connectivity (the CDEM's blocks), made by
     :meth:`Simulation.add_block`. Its nodes carry lumped masses ρ·S/3; its
     triangles the stress (same FVM update as the PCMM elements, weight 1)."""
 

@@ -57,7 +57,7 @@ def _body_turn(q, lb, inertia, k: ti.template(), h):
 def free_rotation(q, L, inertia, rot, dt):
     """The orientation after a step Δt of a rigid body of principal moments
     ``inertia`` (body axes) with the world-frame angular momentum L held over the step
-    (PHYSICS §8: a splitting rotation update; the symmetric composition of the exact
+    (a splitting rotation update; the symmetric composition of the exact
     flows about the three body axes of Dullweber, Leimkuhler & McLachlan 1997, whose
     |L| is exact and whose energy error stays bounded). ``rot`` is the rotation of q.
     Returns (q_{n+1}, ω_{n+1/2} = R I⁻¹ Rᵀ L at q_{n+1})."""

@@ -156,7 +156,7 @@ def cell_index(c, gridn: ti.template()):
 @ti.func
 def image(d, per):
     """The nearest periodic image of the offset d: per = (x0, Lx, y0, Ly[, z0, Lz]), a
-    length 0 where the axis is not periodic (PHYSICS §8: contacts across the boundary
+    length 0 where the axis is not periodic (contacts across the boundary
     are between images)."""
     for k in ti.static(range(d.n)):
         if per[2 * k + 1] > 0.0:

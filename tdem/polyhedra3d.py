@@ -1,4 +1,4 @@
-"""Contacts of convex polyhedra (3D, PHYSICS §9) inside the step kernel.
+"""Contacts of convex polyhedra (3D, Chen's polyhedral DEM) inside the step kernel.
 
 The same stages as a sphere contact (:func:`tdem.step.pair_contact`): the geometry of
 the pair, the kinematics at the contact point, the law, the force and moments.

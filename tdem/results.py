@@ -83,7 +83,7 @@ class Results:
         return out
 
     def _particles_numpy_3d(self):
-        """Particle state of a 3D simulation (API.md): position, velocity, omega (N, 3),
+        """Particle state of a 3D simulation (docs/api.md): position, velocity, omega (N, 3),
         orientation (N, 4) unit quaternions (w, x, y, z), radius, mass, force, torque
         (N, 3), displacement (N, 3)."""
         if self._n == 0:
@@ -136,7 +136,7 @@ class Results:
         whist = a["whist"].to_numpy()
         R = _claw.history_width(self._law_set)     # the rolling couple's column
         if d == 3:
-            # (API.md) the tangential force as a vector: the spring's 3 columns
+            # (docs/api.md) the tangential force as a vector: the spring's 3 columns
             T = _claw.tangent_dim(3)
             cf = a["cf"].to_numpy()[ii, kk, :3]
             wcf = a["wcf"].to_numpy()[wi, wk, :3]

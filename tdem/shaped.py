@@ -1,4 +1,4 @@
-"""Contacts of shaped particles (superellipses, PHYSICS §7) inside the step kernel.
+"""Contacts of shaped particles (superellipses, Miyata et al. 2002, §2.3) inside the step kernel.
 
 The same stages as a disc contact (:func:`tdem.step.pair_contact`): geometry
 (:mod:`physics.geometry.superellipse`: depth, normal, support points), kinematics at

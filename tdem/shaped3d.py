@@ -1,4 +1,4 @@
-"""Contacts of ellipsoids (3D, PHYSICS §8) inside the step kernel.
+"""Contacts of ellipsoids (3D, Miyata et al. 2002, §2.4) inside the step kernel.
 
 The same stages as a sphere contact (:func:`tdem.step.pair_contact`): geometry
 (:mod:`physics.geometry.ellipsoid`: depth and normal by Newton on the unit sphere,

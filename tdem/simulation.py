@@ -1013,7 +1013,7 @@ class Simulation(Runner, Results):
             if inertia is not None and (sel & shaped).any():
                 # a shape also turns under a contact force: its contact point moves as a
                 # mass m* = 1/(1/m + r_b²/I), which is below both m and the I/r_b² of
-                # PHYSICS §7's 2·sqrt(I/(k r_b²)): 2·sqrt(m*/k) bounds both
+                # Miyata et al.'s 2·sqrt(I/(k r_b²)): 2·sqrt(m*/k) bounds both
                 rot = sel & shaped
                 kr = law.critical_stiffness(r[rot], m[rot])
                 mstar = 1.0 / (1.0 / m[rot] + r[rot] ** 2 / inertia[rot])

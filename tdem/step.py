@@ -9,7 +9,7 @@
       -> energy account at t_n, skin check (raises the rebuild flag)
       -> walls move
 
-Conventions (spec §0–1): n points from i to j, t = n rotated +90°, F_n is
+Conventions (Cundall & Strack 1979): n points from i to j, t = n rotated +90°, F_n is
 compression-positive, the force on i is −F_n n + F_s t, ω × r = ω(−r_y, r_x).
 Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
 """

@@ -1,7 +1,7 @@
 """Applied loads: forces and moments on particles (``sim.apply_force``), forces and
 pressures on block nodes (``Block.apply_force``, ``Block.apply_pressure``), constant or
 functions of time. Checked against motion under a known force and against the static
-solutions of loaded columns (PHYSICS §4: nodes may carry an applied force)."""
+solutions of loaded columns (a node may carry an applied force)."""
 import math
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""3D ellipsoids (PHYSICS §8): the penetration depth against a brute-force search, the
+"""3D ellipsoids (Miyata et al. 2002, §2.4): the penetration depth against a brute-force search, the
 torque-free rotation (|L| and energy kept, the flip about the intermediate axis with
 the period of the Jacobi elliptic solution), an ellipsoid coming to rest on its
 shortest axis at the Hertz height, and a sphere-shaped ellipsoid giving the sphere's

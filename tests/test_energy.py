@@ -1,4 +1,4 @@
-"""Energy account and static equilibrium of many discs (C&S 1979; spec §1).
+"""Energy account and static equilibrium of many discs (Cundall & Strack 1979).
 
 (a) Frictionless, undamped discs bouncing in a closed box under gravity:
     total = kinetic + gravitational + elastic + dissipated − boundary work is a

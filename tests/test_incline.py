@@ -9,7 +9,7 @@ Closed forms (rigid-body mechanics with Coulomb friction μ):
 - μ ≥ tan θ / 3: rolls without slipping, a = (2/3) g sin θ and ω R = −v;
 - μ < tan θ / 3: slides, a = g (sin θ − μ cos θ), angular acceleration
   α R = 2 μ g cos θ (friction torque μ m g cos θ R over ½ m R²);
-- rolling resistance Model 1 (spec §2, wall: r̄ = 2R, B = 2δR, M₀ = F_n B/6):
+- rolling resistance Model 1 (Jiang, Yu & Harris 2005, wall: r̄ = 2R, B = 2δR, M₀ = F_n B/6):
   the disc holds while m g sin θ R ≤ M₀ = m g cos θ δ R/3, i.e. tan θ ≤ δ/3;
   above it rolls with a = (2/3) g (sin θ − (δ/3) cos θ).
 """

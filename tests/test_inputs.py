@@ -1,4 +1,4 @@
-"""Bad input (API.md, "Rules that go with the contract"): a ValueError
+"""Bad input (docs/api.md, its rules for input): a ValueError
 (tdem.InputError) whose message names the argument and the bad value; nothing
 half-built is left behind; an unstable run raises tdem.InstabilityError naming the
 step, the time and the particle, and keeps the last good state."""

@@ -81,7 +81,7 @@ def _turn_spring(v: ti.types.ndarray(), n: ti.types.ndarray(), out: ti.types.nda
 
 
 def test_spring_turned_onto_the_tangent_plane_keeps_its_length():
-    """PHYSICS §8: the shear spring is turned onto the current tangent plane with its
+    """The shear spring is turned onto the current tangent plane with its
     length kept. Normals turned from the spring's plane by 1e-9 to 0.5 rad (the
     series branch below a turn of 1e-3 rad, the exact one above): the result lies in
     the plane, keeps |F_s| to 2 ulp and points where the exact projection does."""

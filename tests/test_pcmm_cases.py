@@ -3,7 +3,7 @@
 The default run checks the FVM block model and the regular and hexagonal ("cross")
 PCMM lattices, and the random packing of wave_bar and elastic_gravity; the random
 packing of uniaxial_compression (slower to build and to run) is in the slow tests. Targets and tolerances
-are those of the case docstrings (CASES.md).
+are those of the case docstrings (docs/cases.md).
 """
 import math
 

@@ -213,7 +213,7 @@ def _reference_elements(x, r, tol):
 
 def _reference_cover(x, triangles, sample):
     """N_e by brute force: every element sharing a particle with e (the spec's rule,
-    PHYSICS.md §3: in an unfolded element system only these can cover e's probe;
+    Feng, Li & Oñate 2015, §2: in an unfolded element system only these can cover e's probe;
     the deformed packing below folds elements over others that share no particle
     with them, which the rule leaves out) tested against the probe of e."""
     t = np.asarray(triangles)

@@ -1,4 +1,4 @@
-"""Periodic boundaries (PHYSICS §8) and a conservative gas of superellipses.
+"""Periodic boundaries and a conservative gas of superellipses.
 
 - Two discs colliding across the periodic boundary bounce as the same two discs do in
   the open (to round-off), and positions wrap into the period while the displacement

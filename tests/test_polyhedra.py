@@ -1,4 +1,4 @@
-"""Convex polyhedra with the overlap-volume contact (PHYSICS §9, Chen): mass properties
+"""Convex polyhedra with the overlap-volume contact (Chen's polyhedral DEM): mass properties
 against closed forms and an independent hull, the overlap polyhedron against exact
 half-space intersections and its normal against −∂V/∂x, and the dynamics against
 rigid-body mechanics and the chain's sound speed: rest on a face, sliding and tipping

@@ -1,4 +1,4 @@
-"""Rolling resistance of Jiang, Yu & Harris (2005) at one contact (spec §2).
+"""Rolling resistance of Jiang, Yu & Harris (2005) at one contact.
 
 Two discs (or a disc and a wall) are held in place with a fixed normal overlap u,
 so F_n = K_n u; one disc is spun at a prescribed ω, the relative rotation

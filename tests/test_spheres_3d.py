@@ -1,5 +1,5 @@
 """3D spheres and triangle-mesh walls against Hertz theory and rigid-body mechanics
-(PHYSICS §8): normal impacts, oblique impacts in the sliding regime, rolling down a
+(Miyata et al. 2002, §2.4): normal impacts, oblique impacts in the sliding regime, rolling down a
 triangulated incline across its seams, seams and vertices of a flat mesh felt as one
 plane, energy of a frictionless gas, and the 3D inputs refused."""
 import math

@@ -1,4 +1,4 @@
-"""Superellipse particles (PHYSICS §7): geometry, contact depth, and mechanics against
+"""Superellipse particles (Miyata et al. 2002, §2.3): geometry, contact depth, and mechanics against
 closed forms.
 
 - Area, polar moment and support function against a fine polygon of the boundary.
@@ -48,7 +48,7 @@ def test_area_inertia_and_support_against_a_fine_polygon(s):
 
 @pytest.mark.parametrize("s", SHAPES, ids=repr)
 def test_bounding_radius_holds_the_whole_boundary(s):
-    """PHYSICS §7 gives max(a, b); for n > 2 the corners reach beyond it (a square of
+    """Miyata et al. (2002) give max(a, b); for n > 2 the corners reach beyond it (a square of
     n = 4 to 2^(1/4) a), and the neighbour search would miss corner contacts."""
     far = np.linalg.norm(_polygon(s, 1_000_000), axis=1).max()
     assert far <= s.bounding_radius <= far * (1 + 2e-6)

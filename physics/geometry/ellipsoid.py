@@ -1,4 +1,4 @@
-"""Geometry of ellipsoids (3D, PHYSICS §8; Miyata et al. 2002 §2.4).
+"""Geometry of ellipsoids (3D, Miyata et al. 2002, §2.4).
 
 An ellipsoid of semi-axes (a, b, c) turned by the unit quaternion q (body to world,
 rotation R) has the shape matrix M = R diag(a², b², c²) Rᵀ, the support function

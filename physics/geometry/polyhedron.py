@@ -1,4 +1,4 @@
-"""Overlap of two convex polyhedra (PHYSICS §9), in fixed-size local buffers.
+"""Overlap of two convex polyhedra (Chen's polyhedral DEM), in fixed-size local buffers.
 
 The overlap O = A ∩ B of two convex bodies, each given by its vertices, its face planes
 n·x <= d (outward unit normals) and its edges (two vertices, two faces), is a convex

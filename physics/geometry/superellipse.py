@@ -1,6 +1,6 @@
 """Geometry of superellipses (and discs) against each other and against segments (2D).
 
-PHYSICS §7. A shape is (a, b, n) in its body frame, turned by the angle θ; a disc of
+Miyata et al. 2002, §2.3. A shape is (a, b, n) in its body frame, turned by the angle θ; a disc of
 radius r is (r, r, 2). Its support function h(u) = ‖(a u'_x, b u'_y)‖_q, q = n/(n − 1),
 u' = R(−θ) u, gives the support point p(u) = R(θ) ∇h(u') (the boundary point of outward
 normal u, from the centre).

@@ -1,6 +1,7 @@
 """The engine-side element system: candidates and the lazy rebuild.
 
-These kernels run inside :class:`tdem.Simulation`'s step (spec §3 order):
+These kernels run inside :class:`tdem.Simulation`'s step (in the order of Feng,
+Li & Oñate 2015, §2):
 :func:`candidates` after each neighbour-list build, the others every step from
 :func:`physics.pcmm.update` before the stress pass (:mod:`physics.pcmm.stress`).
 Particles of one PCMM body share a material slot ``pmat[i] >= 0`` (−1: a plain DEM

@@ -10,8 +10,8 @@ from .stress import eos_volumes, equation_of_state, stresses
 
 
 def update(a, e, dt, time, first, full, carry, eos, serial, mixed=True):
-    """One PCMM step (spec §3, steps 1–5 and Eqs. 15–16) for the particles of x_n
-    moving at v_{n−1/2}, in the order the data flows. ``a``: the continuum's arrays
+    """One PCMM step (Feng, Li & Oñate 2015, §2: steps 1–5 and Eqs. 15–16) for the
+    particles of x_n moving at v_{n−1/2}, in the order the data flows. ``a``: the continuum's arrays
     (:class:`tdem.continuum.Continuum`), ``e``: the engine's (positions, velocities,
     pair lists and slots). ``first``: the first step of the run; ``full``: rebuild
     everything (first step, after a restore); ``carry``: an element that existed
