@@ -288,7 +288,8 @@ def run_test(task, output=None, vtu_snapshots=0, specimen_dir=None, spec=None):
     """One biaxial test: the specimen of ``task`` compressed with its rolling resistance.
 
     ``task``: dict with n, confining (Pa), model (0, 1, 2), delta, strain_rate (1/s),
-    axial_strain, seed, threads, arch. ``output``: a folder for the VTU series and
+    axial_strain, seed, threads, arch; optional local_damping (of the compression;
+    default the specimen's, 0.7). ``output``: a folder for the VTU series and
     ``monitors.h5`` (the wall stresses and the specimen's size; None: none).
     ``specimen_dir``: a folder to save the specimen's checkpoint in (None: none).
     ``spec``: the specimen to compress (None: :func:`specimen_for` the task).
@@ -299,10 +300,17 @@ def run_test(task, output=None, vtu_snapshots=0, specimen_dir=None, spec=None):
     (the specimen after compression, only with ``output``).
     """
     from cases import _specimen as specimen
+    from tdem.errors import InputError
     clock = common.Stopwatch()
     model, delta = check_material(task["model"], task["delta"])
     if spec is None:
         spec = specimen_for(task, specimen_dir)
+    damping = task.get("local_damping")
+    if damping is not None:
+        # the compression's local damping (the specimen was made with 0.7)
+        if not (isinstance(damping, (int, float)) and 0.0 <= damping < 1.0):
+            raise InputError(f"local_damping must lie in [0, 1), got {damping!r}")
+        spec.sim.local_damping = float(damping)
     before = spec.state()
     writer = None
     if output is not None:
@@ -368,7 +376,7 @@ def run_task(task):
 
 
 def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None, preparation="layers",
-                seeds=None, rates=None):
+                seeds=None, rates=None, local_damping=None):
     """The tasks of a sweep: every material of ``cfg`` at every confining stress, for
     every specimen seed (``seeds``, default ``cfg``'s seed) and strain rate at 200 kPa
     (``rates``, default ``cfg``'s; at other stresses :func:`strain_rate_at`)."""
@@ -388,7 +396,7 @@ def sweep_tasks(cfg, confining=CONFINING, materials=None, arch=None, preparation
     return [{"n": cfg["n"], "confining": float(s), "model": int(m), "delta": float(d),
              "strain_rate": strain_rate_at(float(rate), float(s)),
              "axial_strain": cfg["axial_strain"], "seed": int(seed), "arch": arch,
-             "preparation": preparation}
+             "preparation": preparation, "local_damping": local_damping}
             for seed in seeds for rate in rates for s in confining for (m, d) in materials]
 
 
@@ -466,7 +474,9 @@ def result_file(folder, task):
                            f"_rate{task['strain_rate']:.6g}_strain{task['axial_strain']:g}"
                            f"_n{task['n']}_seed{task.get('seed', SEED)}"
                            + ("" if task.get("preparation", "layers") == "layers" else
-                              f"_{task['preparation']}") + ".h5")
+                              f"_{task['preparation']}")
+                           + ("" if task.get("local_damping") is None else
+                              f"_damping{task['local_damping']:g}") + ".h5")
 
 
 def run_sweep(tasks, scheduler=None, workers=2, keep=None):
@@ -817,6 +827,8 @@ def _extra(p):
     p.add_argument("--rates", type=float, nargs="+", default=None, metavar="RATE",
                    help="with --sweep: strain rates at 200 kPa in 1/s (default: the "
                         "preset's); the convergence with the rate in sweep.md")
+    p.add_argument("--local-damping", type=float, default=None, metavar="ALPHA",
+                   help="local damping of the compression (default 0.7, the preparation's)")
     p.add_argument("--stresses", type=float, nargs="+", default=None, metavar="PA",
                    help="with --sweep: confining stresses in Pa (default 100e3 200e3 400e3)")
 
@@ -860,7 +872,7 @@ def _main_sweep(args, out, cfg, clock):
         sweep["materials"] = [parse_material(m) for m in args.materials]
         sweep["axial_strain"] = cfg["axial_strain"]
     tasks = sweep_tasks(sweep, arch=args.arch, preparation=args.preparation, seeds=args.seeds,
-                        rates=args.rates,
+                        rates=args.rates, local_damping=args.local_damping,
                         confining=CONFINING if args.stresses is None else args.stresses)
     print(f"biaxial sweep ({args.preset}"
           f"{', all deltas' if args.all_deltas else ''}): {len(tasks)} tasks on "
@@ -954,7 +966,8 @@ def main(argv=None):
         envelope_confining = cfg["envelope_confining"]
     base = {"n": cfg["n"], "axial_strain": cfg["axial_strain"], "seed": SEED,
             "threads": args.threads, "arch": args.arch, "preparation": args.preparation,
-            "compaction_friction": args.compaction_friction}
+            "compaction_friction": args.compaction_friction,
+            "local_damping": args.local_damping}
     results = []
     specimen_dir = out / "specimens"
     rate = strain_rate_at(cfg["strain_rate"], args.confining)
@@ -1043,7 +1056,8 @@ def main(argv=None):
         "specimen": {"state": before, "grading": g, "preparation": spec0.history},
         "parameters": {
             "n": cfg["n"], "kn": 2e8, "ks": 1.5e8, "friction": 0.5, "density": DENSITY,
-            "wall_friction": 0.0, "local_damping": 0.7, "strain_rate": rate,
+            "wall_friction": 0.0, "strain_rate": rate,
+            "local_damping": 0.7 if args.local_damping is None else args.local_damping,
             "preparation": args.preparation,
             "layers": LAYERS if args.preparation == "layers" else None,
             "compaction_friction": (None if args.preparation != "layers" else

@@ -360,3 +360,14 @@ def test_materials_of_a_sweep_are_parsed_and_checked():
         biaxial.parse_material("3:0.4")
     with pytest.raises(tdem.InputError, match="delta must be 0 without"):
         biaxial.parse_material("0:0.4")
+
+
+def test_local_damping_of_the_compression_is_checked_and_named_in_the_results(tmp_path):
+    tasks = biaxial.sweep_tasks(dict(TINY, materials=[(0, 0.0)]), confining=(1e5,),
+                                local_damping=0.3)
+    assert tasks[0]["local_damping"] == 0.3
+    assert biaxial.result_file(tmp_path, tasks[0]).name.endswith("_damping0.3.h5")
+    plain = biaxial.sweep_tasks(dict(TINY, materials=[(0, 0.0)]), confining=(1e5,))[0]
+    assert "damping" not in biaxial.result_file(tmp_path, plain).name
+    with pytest.raises(tdem.InputError, match="local_damping must lie in"):
+        biaxial.run_test(dict(tasks[0], local_damping=1.2), spec=object())
