@@ -29,7 +29,7 @@ COMMAND = None
 #: ``python -m cases.report --write`` from the summaries (docs/cases.md)
 # quick-times:start
 QUICK_WALL_S = {
-    "nine_disc": 10, "photoelastic": 23, "biaxial": 46, "elastic_gravity": 10,
+    "nine_disc": 10, "photoelastic": 23, "biaxial": 80, "elastic_gravity": 10,
     "uniaxial_compression": 18, "wave_bar": 38, "soil_cutting": 22,
     "contact_burst": 160, "water_blocks": 81, "plate_loading": 76,
     "ellipsoid_compression": 54, "impact_benchmarks": 24, "angle_of_repose": 503,
