@@ -314,7 +314,7 @@ class Fluid(Material):
     viscosity : dynamic viscosity μ (Pa·s), ≥ 0: the stress 2μ·dev(D) on the
         element forces of each step (not accumulated)
     linear_viscosity, quadratic_viscosity : artificial bulk viscosity b1, b2 ≥ 0
-        (module docstring; 0 = off)
+        (dimensionless; module docstring; 0 = off)
     tensile_strength : only with ``equation_of_state``: the largest tension
         (negative pressure) the fluid carries, Pa, ≥ 0 (default 0)
     equation_of_state : False (default): the pressure is the elements'
@@ -328,6 +328,10 @@ class Fluid(Material):
         of that sum over the step's elements and over those that pushed over
         it); an element pushes with the
         mean pressure of its three particles, plus the viscous stress and q.
+    shear_modulus : G_s (Pa), ≥ 0 and below K (default 0); with
+        ``relaxation_time`` > 0 it makes a Maxwell fluid (below). Incremental
+        pressure only.
+    relaxation_time : τ (s), ≥ 0; > 0 whenever ``shear_modulus`` is.
     voronoi : False (default): the pressure of the elements (above). True: the
         body makes no elements; each particle's pressure is K·max(A0/A − 1, 0) from
         the area A of its Voronoi cell among the particles of its body (cut by the
@@ -336,173 +340,34 @@ class Fluid(Material):
         ``viscosity`` acts between neighbouring cells, μ Σ (l/d)(v_j − v_i), and
         the artificial bulk viscosities on each shrinking cell as on an element.
         Not with ``equation_of_state``, ``tensile_strength`` or a shear modulus.
-        It is the option for water packed at random (below).
 
-    Contacts between water particles. Two particles of one Fluid body that are
-    Eq. 1 neighbours never meet through the contact law; they repel through the
-    core force of :func:`physics.pcmm.fluid_core_force`, K·max(0, 0.75·(R_i +
-    R_j) − d), a function of their distance only. Why: with G = 0 the triangles
-    resist only area changes, so two particles of one triangle can approach each
-    other at constant area down to the Eq. 3 edge limit (0.5 × the mean radius,
-    i.e. an overlap of 1.5 R) before the Eq. 2 angle check deletes the triangle;
-    the spec's rule (touching particles that share no element meet through the
-    contact law, in total form F = k_n·u_n) then switches on a force k_n × that
-    overlap in one step. In a water column of 0.3 × 0.4 m released as a dam
-    break (R = 1 cm, K = 2 MPa) this threw the toe particles out at 100 m/s
-    after 0.08 s, at any time step (0.5 and 0.1 × the critical one); the water
-    column at rest of R = 6–14 mm random discs, and the reported corner
-    instability of the wall-bounded column, are the same event. The core force
-    does no work unless two particles overlap by a quarter of their radii, far
-    beyond the water's compression (p/K < 1 %), so it leaves the pressure alone.
+    Model choices
+    -------------
+    - Contacts between water particles: two particles of one Fluid body that are
+      Eq. 1 neighbours never meet through the contact law; they repel through the
+      core force of :func:`physics.pcmm.fluid_core_force`, K·max(0, 0.75·(R_i +
+      R_j) − d), a function of their distance only. With G = 0 the triangles
+      resist only area changes, so two particles of one triangle can approach
+      each other at constant area until the Eq. 2 angle check deletes it, and the
+      contact law would then switch on a large force in one step. The core force
+      does no work unless two particles overlap by a quarter of their radii, far
+      beyond the water's compression (p/K < 1 %), so it leaves the pressure alone.
+    - Packing: the elements' water (incremental pressure) comes to rest on a
+      square lattice; on a hexagonal lattice or a random packing the elements do
+      not hold it still (zero-energy modes of the G = 0 triangles, triangles of a
+      random packing that do not tile the body), and the equation of state creeps
+      even on the square lattice. ``voronoi=True`` is the option for water packed
+      otherwise: the Voronoi cells tile every packing.
+    - Maxwell fluid (``shear_modulus`` G_s > 0 with ``relaxation_time`` τ > 0):
+      the triangles carry a shear stress 2G_s·dev(Δε) whose deviatoric part
+      relaxes by exp(−Δt/τ) every step (the mean stress is kept), so that over
+      times shorter than τ the lattice's zero-energy modes meet a shear stiffness
+      and at rest the stress relaxes to the hydrostatic one. Over times longer
+      than τ it flows with the viscosity η = G_s·τ: it suits a slow, viscous body
+      or a reservoir at rest, not water that must both rest and flow on a
+      hexagonal packing.
 
-    The two pressure models, measured (tests/test_fluid.py set-up: 0.4 × 0.5 m,
-    R = 1 cm square lattice, K = 2 MPa, μ = 1 Pa·s, damped 0.3 s, then free):
-    the incremental model holds the column at rest (largest speed < 1e-6 m/s
-    over 3 s undamped); the equation of state lets it creep along the
-    zero-energy shear modes of the G = 0 lattice (largest speed growing from
-    1 to 4 mm/s over 1.2 s, then the column rearranges after 1.8 s), because
-    averaging the particle pressures over each triangle leaves the lattice
-    without an exact equilibrium. In Martin & Moyce's dam break (h = 2a,
-    a = 0.3 m, R = 1 cm square lattice; tests/test_fluid.py) the incremental
-    model's surge front leads their measured x/a by −0.3 to +11.5 % up to T =
-    t·sqrt(2g/a) = 3.3. The measurements below that were taken on a lower
-    column, h = sqrt(2)·a (their n² = 2 read as n = h/a; there the incremental
-    model kept within 2 %): the equation of state ran 4–16 % ahead of it. In both,
-    the water's area grows (7 % by T = 2.5 incremental, 4 % equation of state) as
-    the particles of the thinning front spread apart. Both lose volume
-    when a random packing flows (the area of deleted triangles is not
-    returned to anyone), so water is best packed on a lattice. The same dam break
-    packed otherwise (incremental pressure; measured 2026-12-05), its front against
-    Martin & Moyce at T = 0.83, 1.22, 2.0, 2.55, 3.3: random discs of 0.8–1.2 R at
-    80 % (``tdem.pack.random``) +7.8, +4.7, −5.4, −10.6, −14.7 %; the same at 89 %
-    with the holes of the element cover filled (``overlap_tol=0.7``,
-    ``pcmm_tolerance=R``) +22, +23, +7, −3, −14 %; hexagonal lattice +0.3, −3, −27,
-    −38, −42 %.
-
-    Packings other than the square lattice, measured (0.3 × 0.5 m column, R = 5
-    mm, K = ρ(10·sqrt(2gh))² = 0.98 MPa, μ = 1 Pa·s, frictionless walls, local
-    damping 0.7, released at zero pressure, 1 s):
-
-    - hexagonal lattice (``tdem.pack.cross``), incremental pressure: the particle
-      pressures' median is ρgd but single particles read −0.07 to 2.2 × ρgd
-      (the triangles' pressures alternate by about ±ρgd between the up and the
-      down triangles, a pattern that pushes no particle), the largest speed stays
-      at 0.006–0.03 m/s and the lattice rearranges (7 % more elements after 1 s).
-      The release excites the first sloshing mode of the tank, which local
-      damping hardly damps, and the G = 0 triangles (two area constraints per
-      particle, as many as its degrees of freedom) give way along zero-energy
-      modes. With ``equation_of_state`` the particles at the walls speed up to
-      0.6 m/s at ``dt_fraction`` 0.5, and to 1.7 m/s with mass-proportional
-      damping 30 /s as well; at ``dt_fraction`` 0.25 they do not (largest speed
-      0.02–0.06 m/s, pressures 0.57–1.09 × ρgd), so the step bound of the
-      elements (altitude / c_p) does not bound the particle pressure's step
-      there. A deviatoric stiffness 2G_s·dev(Δε_e − Δε̄) against each
-      triangle's departure from the strain of its neighbourhood (G_s = 0.05 K;
-      tried, not offered) holds the column at rest (1e-4 m/s) with pressures of
-      0.92–0.99 × ρgd, and blows up on a random packing.
-    - random packings: the overlapping triangles of neighbouring particles' rings
-      do not tile the body, so a uniform pressure p pushes interior particles by
-      up to 3 R × p per metre (tests/test_fluid.py,
-      ``test_lattice_element_systems_are_conformal``): under ρgd, about d/R
-      times a particle's weight. Water there does not come to rest.
-
-    A Maxwell fluid (``shear_modulus`` G_s > 0 with ``relaxation_time`` τ > 0; the
-    incremental pressure only): the triangles carry a shear stress 2G_s·dev(Δε)
-    whose deviatoric part relaxes by exp(−Δt/τ) every step (the mean stress is
-    kept), so that over times shorter than τ the lattice's zero-energy modes meet a
-    shear stiffness, and at rest the stress relaxes to the hydrostatic one. The
-    hexagonal column above (R = 5 mm, 1.3 s, measured 2026-12-05):
-
-    ============================== ============ ============== ========== ============
-    material                       largest      p/ρgd, single  p against  elements
-                                   speed (m/s)  particles      depth      after 1 s
-    ============================== ============ ============== ========== ============
-    Fluid (G = 0)                  0.2–0.4      −2.0 to 2.8    1.04 ρg    +10 %
-    G_s = 0.01 K, τ = 0.1 s        1.4e-3       0.67–1.30      0.99 ρg    unchanged
-    G_s = 0.01 K, τ = 0.02 s       5e-3         0.59–1.54      0.997 ρg   unchanged
-    G_s = 0.05 K, τ = 0.1 s        5e-4         0.82–1.14      0.985 ρg   unchanged
-    G_s = 0.01 K, τ = 0.005 s      0.016        −0.2 to 2.0    1.01 ρg    +11 %
-    G_s = 0.01 K, τ = 0.001 s      0.35         −0.6 to 2.1    0.86 ρg    +9 %
-    tdem.Elastic, G = 0.01 K       1e-4         0.90–1.03      (median    unchanged
-    (no relaxation)                                            0.944)
-    ============================== ============ ============== ========== ============
-
-    The Maxwell column stays at rest with its elements and area (within 4e-5) and its
-    pressure grows at ρg within 1–2 %, but single particles' pressures scatter about
-    that line by 15–50 %: the scatter is a pressure pattern of the triangles that
-    pushes no particle, which the shear stress does not see (measured, G_s = 0.01 K,
-    τ = 0.1 s at 1.3 s: the triangles' pressures depart from the fit ρg·depth by
-    52 ρgR rms, ±4.8 ρgR of it between the lattice's up and down triangles, and that
-    departure pushes the interior particles with 0.09 N/m (median; 0.41 at most),
-    against 26 N/m for an unbalanced pattern of its size: a particle's weight is 0.77
-    N/m; a particle's pressure is the mean over its triangles, and reads the
-    pattern). An elastic solid of the same G scatters less but carries the lateral
-    stress of a confined solid (ν/(1 − ν) of the vertical), not a hydrostatic one. On the random packing (radii 0.8–1.2 R,
-    80 % of the area) the Maxwell fluid still flows (0.13–0.3 m/s): its triangles do
-    not tile the body, and the shear stiffness cannot hold the push below.
-
-    The price: over times longer than τ a Maxwell fluid flows with the viscosity
-    η = G_s·τ, and the column holds still only where η is that of a syrup. G_s = 0.01
-    K, τ = 0.1 s is η = 2000 Pa·s at K = 2 MPa: in Martin & Moyce's dam break
-    (the test_fluid set-up with h = sqrt(2)·a, square or hexagonal lattice) its
-    surge front lags their measurements by 11 % at T = 0.83 and by 69 % at T = 3.3;
-    at τ = 0.005 s (η = 100
-    Pa·s) it lags by 3–41 % and the column at rest rearranges again. (The plain
-    Fluid's front on the hexagonal lattice lags by 0–42 %, on the square lattice it
-    keeps within 2 %.) So the option suits a slow, viscous body or a reservoir at
-    rest; water that must both rest and flow on a hexagonal packing it does not give.
-    The same relaxing shear stress on the equation of state's nodal pressure (tried,
-    not offered): 9e-3 m/s at τ = 0.1 s with single pressures of 0.3–1.6 ρgd and 1 %
-    more elements, 0.08 m/s at τ = 0.01 s. Nor does a wider Eq. 1 tolerance: with
-    δ = 1.5 or 1.8 R the hexagonal lattice's second ring of neighbours joins the
-    elements (11,900 against 9,576), and the plain Fluid column still moves at 0.2
-    m/s with single pressures of −1.4 to 2.6 ρgd.
-
-    What would hold on any packing is an element system that tiles (a Delaunay
-    triangulation of the centres within the Eq. 1 distance, kept by edge flips)
-    with a pressure stabilised against both the checkerboard and the zero-energy
-    modes. ``voronoi=True`` takes the tiling's dual instead: the particles' Voronoi
-    cells tile every packing, change continuously as particles pass each other,
-    and give each particle its own area, so there is no element pressure pattern
-    to hide. Measured (tests/test_voronoi_water.py: the 0.3 × 0.5 m column above,
-    R = 5 mm, K = ρ(10·sqrt(2gh))², no viscosity, damping 0.7, 1 s), depth from
-    the water's surface Σ A / W (2.4 R above the top centres, where the cells of
-    the surface end):
-
-    ========== =============== ============================ ========== ==========
-    packing    largest speed   p against ρg·depth, below    area       elements
-               (× sqrt(gh))    the top row
-    ========== =============== ============================ ========== ==========
-    square     3e-6            0.24 %                       −0.25 %    none
-    hexagonal  5e-5            0.24 %                       −0.25 %    none
-    random     4e-3            0.31 %                       −0.25 %    none
-    ========== =============== ============================ ========== ==========
-
-    (−0.25 % is the column's compression, ρgh/2K.) The discs that close the cells
-    have one radius per body: with 2.5 R_i each (the first version), the random
-    packing's second and third layers read 3–6 % off the line, the surface
-    cells of its small and large particles reaching up unequally. Martin &
-    Moyce's dam break on the random packing (h = 2a, K = 2 MPa, μ = 1 Pa·s) keeps
-    the water's area Σ min(A, A0) within 0.11 % to T = 3.35 and, without
-    viscosity, its energy within 2e-5; its front leads their measurements by
-    10–17 % (11–19 % inviscid; with R = 7.5 and 3.5 mm instead of 5 mm by 9.5–15
-    and 9.7–16 %), as a volume-of-fluid solution of the same problem does
-    (OpenFOAM interFoam: +10.7 to +17.1 %; even water at the experiment's scale
-    with no-slip walls leads by 9.5–16.5 %): the cells' front keeps within 1.3 %
-    of that solution at every time (cases.dam_break, paper preset). The square
-    lattice's element water above (−0.3 to +11.5 % at R = 1 cm, +4.4 to +7.8 % at
-    5 mm) trails the solution by 6–9 % at 5 mm: it dissipates a fifth of its
-    energy as its elements break and form.
-    Tried on the way, not offered: the surface cells at zero pressure with half
-    masses (exact on the square lattice; on the hexagonal one the surface row,
-    which then resists no compression, drifted, its speed growing from 1e-4 to
-    1e-2 × sqrt(gh) in 0.6 s); a penalty on the differences of the cells' relative
-    areas (the square lattice's odd–even pressure pattern, ±0.3 ρgR, stayed: the
-    top row's balance sets it; with the surface cells of the option it does not
-    arise). On a fixed tiling of the hexagonal column, the particle pressure of
-    ``equation_of_state`` with mass-proportional damping (30 /s) reads 0.95–1.00
-    × ρgd, and only the particles where the free surface meets the walls still
-    move (0.03–0.08 m/s).
+    measurements: docs/pcmm.md
     """
 
     _ARGS = ("density", "bulk_modulus", "viscosity", "linear_viscosity",
