@@ -579,9 +579,21 @@ def save_results(path, results, extra=None):
     import json
 
     import h5py
+    seen = {}
+    for r in results:
+        key = (r["task"]["confining"], r["name"])
+        seen[key] = seen.get(key, 0) + 1
     with h5py.File(path, "w") as f:
         for r in results:
-            g = f.require_group(f"sigma{r['task']['confining'] / 1e3:g}kPa/{r['name']}")
+            t = r["task"]
+            name = r["name"]
+            if seen[(t["confining"], name)] > 1:
+                # several specimens, rates or dampings of one test
+                name += (f"_seed{t.get('seed', SEED)}_rate{rate_at_200kpa(t):.6g}"
+                         + ("" if t.get("local_damping") is None else
+                            f"_damping{t['local_damping']:g}"))
+            g = f.create_group(f"sigma{t['confining'] / 1e3:g}kPa/{name}")
+            g.attrs["name"] = r["name"]
             for k, v in r["curves"].items():
                 if np.ndim(v):
                     g.create_dataset(k, data=np.asarray(v, dtype=float))
@@ -615,7 +627,8 @@ def load_results(path):
                 for k in ("sigma_h_target", "strain_rate"):
                     if k in g.attrs:
                         curves[k] = float(g.attrs[k])
-                out.append({"task": json.loads(g.attrs["task"]), "name": name,
+                out.append({"task": json.loads(g.attrs["task"]),
+                            "name": str(g.attrs.get("name", name)),
                             "curves": curves, "phi": json.loads(g.attrs["phi"]),
                             "before": json.loads(g.attrs["before"]),
                             "hold": float(g.attrs["sigma_h_hold"]),

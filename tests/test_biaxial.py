@@ -371,3 +371,17 @@ def test_local_damping_of_the_compression_is_checked_and_named_in_the_results(tm
     assert "damping" not in biaxial.result_file(tmp_path, plain).name
     with pytest.raises(tdem.InputError, match="local_damping must lie in"):
         biaxial.run_test(dict(tasks[0], local_damping=1.2), spec=object())
+
+
+def test_results_of_several_specimens_of_one_test_are_kept_apart(tmp_path):
+    def r(seed, rate, pk):
+        return {"task": {"model": 0, "delta": 0.0, "confining": 2e5, "seed": seed,
+                         "strain_rate": rate}, "name": "none",
+                "curves": {"axial_strain": np.linspace(0, 0.1, 5), "sigma_h_target": 2e5},
+                "phi": {"phi_peak": pk, "phi_residual": pk - 3}, "before": {"void_ratio": 0.25},
+                "hold": 0.001, "wall_s": 1.0}
+    res = [r(0, 0.1, 20.0), r(1, 0.1, 21.0), r(0, 0.5, 22.0)]
+    back = biaxial.load_results(biaxial.save_results(tmp_path / "s.h5", res))
+    assert sorted((b["task"]["seed"], b["task"]["strain_rate"], b["phi"]["phi_peak"])
+                  for b in back) == [(0, 0.1, 20.0), (0, 0.5, 22.0), (1, 0.1, 21.0)]
+    assert {b["name"] for b in back} == {"none"}
