@@ -63,7 +63,7 @@ import math
 import taichi as ti
 
 from physics.validate import in_range, non_negative, positive
-from tdem.launch import cached
+from tdem.core.launch import cached
 
 SLOTS = 4
 VERTEX_DEPTH = 0.05   # deepest vertex–edge penetration taken as a contact, × A

@@ -6,7 +6,10 @@ PCMM element system, a package: ``rules.py``, ``system.py``, ``rebuild.py``,
 ``stress.py``, ``nodal.py``, ``step.py``, ``layout.py``), :mod:`physics.fvm` (the
 triangle stress update), :mod:`physics.materials` and :mod:`physics.blocks`.
 """
-import tdem  # noqa: F401  (the engine first: these modules use its errors)
+# tdem first: these modules import tdem.core, and importing it runs tdem/__init__.py,
+# which loads the engine, which imports this package's modules in its own order; the
+# engine must start before any of them does (tdem/core/__init__.py)
+import tdem  # noqa: F401
 
 from .contact_law import ContactLaw, register_law
 from .linear import LinearContact

@@ -27,7 +27,7 @@ Arrays (all blocks of a simulation concatenated; node indices are global):
 import numpy as np
 import taichi as ti
 
-from tdem.launch import cached
+from tdem.core.launch import cached
 
 from . import fvm
 from .materials import MAT_G, MAT_K, mc_correct_state, mixes

@@ -64,7 +64,7 @@ import math
 
 import taichi as ti
 
-from tdem.errors import InputError
+from tdem.core.errors import InputError
 
 from .rolling import COL_ROLL_DAMP, RollingResistance
 from .validate import non_negative

@@ -13,7 +13,7 @@ Eq. 17. The kernel side is :meth:`LinearContact.force`.
 """
 import taichi as ti
 
-from tdem.errors import InputError
+from tdem.core.errors import InputError
 
 from .contact_law import ContactLaw, register_law, shear_spring_energy, spring_dashpot
 from .validate import positive

@@ -112,7 +112,7 @@ import math
 import numpy as np
 import taichi as ti
 
-from tdem.errors import InputError
+from tdem.core.errors import InputError
 
 from .validate import in_range, non_negative, positive
 

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from tdem.errors import InputError
+from tdem.core.errors import InputError
 
 from .shapes import quaternion_rotations
 from .validate import positive

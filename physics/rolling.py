@@ -24,7 +24,7 @@ stays closed.
 """
 import taichi as ti
 
-from tdem.errors import InputError
+from tdem.core.errors import InputError
 
 from .validate import non_negative
 

@@ -1,7 +1,7 @@
 """Argument checks shared by the parameter classes: clear errors naming the argument."""
 import math
 
-from tdem.errors import InputError
+from tdem.core.errors import InputError
 
 
 def positive(name, value):

@@ -9,7 +9,7 @@ from .ensemble import PLUGIN_NAME, worker_environment
 
 
 def _taichi_started():
-    backend = sys.modules.get("tdem.backend")
+    backend = sys.modules.get("tdem.core.backend")
     return backend is not None and backend._state["arch"] is not None
 
 

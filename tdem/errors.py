@@ -1,23 +1,5 @@
-"""Exceptions raised by tdem."""
-
-
-class InputError(ValueError):
-    """Bad input: the message names the argument and the offending value."""
-
-
-class InstabilityError(RuntimeError):
-    """The run went unstable (NaN, or a particle moving absurdly far in one step).
-
-    The simulation keeps the last good state; ``step``, ``time`` and ``particle``
-    say where it failed.
-    """
-
-    def __init__(self, message, step=None, time=None, particle=None):
-        super().__init__(message)
-        self.step = step
-        self.time = time
-        self.particle = particle
-
-
-class CapacityError(RuntimeError):
-    """A fixed-capacity slot array would overflow and cannot grow further."""
+"""Exceptions raised by tdem: kept under this name for older imports; the classes are
+those of :mod:`tdem.core.errors` (``tdem.errors.InputError is
+tdem.core.errors.InputError``)."""
+from tdem.core.errors import *  # noqa: F401,F403
+from tdem.core.errors import __all__  # noqa: F401

@@ -40,31 +40,13 @@ from physics.geometry import sphere_triangle
 from .launch import cached
 from .state import PROP_RADIUS
 
-# indices in the int status array ``flags``
-F_REBUILD = 0    # 1: lists must be rebuilt before the next force computation
-F_NEED = 1       # largest number of slots any particle needed (half or reverse list)
-F_WALL_NEED = 2  # largest number of wall slots any particle needed
-F_BAD = 3        # smallest index of an unstable particle (n if none)
-F_BUILDS = 4     # number of list builds so far
-F_NONCONV = 5    # shaped-particle contact evaluations whose iteration stopped short
-F_TBIN_NEED = 6  # 3D: entries the triangle bins needed (more than their capacity: the
-                 # build looked at every triangle; the host grows the bins)
-F_TBIN_TOTAL = 7  # 3D: entries of the triangle bins at the last build
-F_SWEEP = 8      # sort-and-sweep (tdem.sweep): 1 while its pair set matches its sorted
-                 # axes; 0 asks the next build to make the set again from the axes
-F_FAST = 9       # 1 + the largest index of a particle that moved more than its radius in
-                 # one step (0: none so far; tdem.step.step raises it, the host reports it)
-F_PUSH = 10      # 1 + the largest index of a particle that the forces of a step pushed
-                 # past what a stable step does (tdem.step.step; 0: none): folded into
-                 # F_BAD and cleared by the status check (tdem.step.check_stability)
-FLAGS_SIZE = 11
-
-# columns of the float parameter array ``simp`` (the step's and the search's)
-P_DT, P_GX, P_GY, P_ALPHA, P_ALPHA_LOCAL, P_SKIN, P_NWALLS = 0, 1, 2, 3, 4, 5, 6
-P_PX0, P_PLX, P_PY0, P_PLY = 7, 8, 9, 10      # periodic axes: start, length (0: none)
-P_GZ, P_PZ0, P_PLZ = 11, 12, 13                # 3D: gravity, periodic z axis
-P_CHUNK = 14                                    # particles per chunk of the step's pair loop
-SIMP_SIZE = 16
+# the columns of the status array ``flags`` (F_*) and of the parameter array ``simp``
+# (P_*) are declared in tdem.core.layout (PCMM kernels share them) and named here too
+from .core.layout import (F_BAD, F_BUILDS, F_FAST, F_NEED, F_NONCONV, F_PUSH,  # noqa: F401
+                          F_REBUILD, F_SWEEP, F_TBIN_NEED, F_TBIN_TOTAL, F_WALL_NEED,
+                          FLAGS_SIZE, P_ALPHA, P_ALPHA_LOCAL, P_CHUNK, P_DT, P_GX, P_GY, P_GZ,
+                          P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0, P_PZ0, P_SKIN,
+                          SIMP_SIZE)
 
 
 @ti.func

@@ -24,16 +24,16 @@ contact's history vector (as wide as the registered contact laws need,
 :mod:`tdem.continuum` keeps the PCMM, block and coupling arrays in the same way
 (``Continuum.a``, its snapshot list).
 """
-import weakref
 from dataclasses import dataclass
 
 import taichi as ti
-from taichi.lang import impl
 
 from physics import contact_law
 from physics.polyhedron import PI_WIDTH, PT_WIDTH
 
-from .launch import cached
+from .core.arrays import ndarray  # noqa: F401  (state.ndarray: the engine's arrays are made by it)
+from .core.launch import cached
+from .core.layout import PROP_INERTIA, PROP_MASS, PROP_RADIUS, PROP_WIDTH  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -47,9 +47,7 @@ class Array:
     doc: str = ""
 
 
-# columns of the particle property vector ``prop``
-PROP_RADIUS, PROP_MASS, PROP_INERTIA = 0, 1, 2
-PROP_WIDTH = 3
+# the columns of the particle property vector ``prop`` (PROP_*) are in tdem.core.layout
 
 # sizes a shape may name: n, cap, capw, walls (>= 1), laws, law_width, cells,
 # cell_starts; and fixed numbers
@@ -212,27 +210,6 @@ def allocate(sizes, fdt, names=None):
         dt = {"f": fdt, "f64": ti.f64, "i32": ti.i32}[a.dtype]
         out[a.name] = ndarray(vec, dt, shp)
     return out
-
-
-def _delete(prog, handle):
-    # only the Taichi program that made the array may free it (a reset made a new one)
-    rt = impl.get_runtime()
-    if rt is not None and rt.prog is prog:
-        prog.delete_ndarray(handle)
-
-
-def ndarray(vec, dtype, shape):
-    """A device array: of ``vec``-vectors (``vec`` > 0) or scalars (``vec`` 0 or None).
-
-    Taichi 1.7 frees a scalar ndarray when it is garbage-collected but never a vector
-    or matrix one (taichi-dev/taichi#8763): every model built and dropped, and every
-    growth of its slots, would keep its memory until the process ends. A vector array
-    made here gets the release that scalar ones have."""
-    if not vec:
-        return ti.ndarray(dtype, tuple(shape))
-    arr = ti.Vector.ndarray(vec, dtype, tuple(shape))
-    weakref.finalize(arr, _delete, impl.get_runtime().prog, arr.arr)
-    return arr
 
 
 def fresh_rows(n, sizes, values):

@@ -37,13 +37,11 @@ from . import polyhedra3d, shaped3d
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
-# columns of the wall array: p0, p1, translation velocity, angular velocity, centre, law
-# W_INVLL = 1/|p1 − p0|²; W_DISP = largest displacement of the wall since the lists were built;
-# servo control: W_SERVO_K > 0 switches it on (stiffness of one contact), target force
-# W_SERVO_F along the unit direction (W_SERVO_DX, W_SERVO_DY), relaxation, speed limit
-(W_X0, W_Y0, W_X1, W_Y1, W_VX, W_VY, W_OMEGA, W_CX, W_CY, W_LAW, W_INVLL, W_DISP,
- W_SERVO_K, W_SERVO_F, W_SERVO_DX, W_SERVO_DY, W_SERVO_ALPHA, W_SERVO_VMAX) = range(18)
-WALL_WIDTH = 18
+# the columns of the wall array (W_*, a segment's row in 2D) are declared in
+# tdem.core.layout (PCMM cells clip against the walls) and named here too
+from .core.layout import (W_CX, W_CY, W_DISP, W_INVLL, W_LAW, W_OMEGA,  # noqa: F401
+                          W_SERVO_ALPHA, W_SERVO_DX, W_SERVO_DY, W_SERVO_F, W_SERVO_K,
+                          W_SERVO_VMAX, W_VX, W_VY, W_X0, W_X1, W_Y0, W_Y1, WALL_WIDTH)
 # 3D: the wall table holds the triangles of the mesh walls (columns T_*, tdem.neighbors)
 
 # the contact forces of a step may move a particle by at most this fraction of its

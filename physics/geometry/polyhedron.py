@@ -407,7 +407,7 @@ def overlap_of(shape_a, x_a, q_a, shape_b, x_b, q_b):
     {"volume", "centroid", "s_a", "s_b", "status"} (host entry for tests and checks)."""
     import numpy as np
 
-    from tdem.backend import init
+    from tdem.core.backend import init
     init()
     rows = [shape_a.table_rows(), shape_b.table_rows()]
     out = np.zeros(11)
@@ -423,7 +423,7 @@ def prism_overlap_of(shape, x, q, triangle, depth):
     of the cut on the triangle's plane), "status"}."""
     import numpy as np
 
-    from tdem.backend import init
+    from tdem.core.backend import init
     init()
     f, i = shape.table_rows()
     out = np.zeros(11)

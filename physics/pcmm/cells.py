@@ -55,8 +55,8 @@ import math
 
 import taichi as ti
 
-from tdem.launch import cached
-from tdem.state import PROP_MASS
+from tdem.core.launch import cached
+from tdem.core.layout import PROP_MASS, W_X0, W_X1, W_Y0, W_Y1
 
 from ..materials import MAT_K, MAT_RHO, MAT_VISC
 from .stress import bulk_viscosity
@@ -144,8 +144,8 @@ def cells(pos: ti.types.ndarray(), vel: ti.types.ndarray(), prop: ti.types.ndarr
                 lab[k] = NO_FACE
             nv = SIDES
             for w in range(nwalls):
-                a = ti.Vector([wall[w, 0], wall[w, 1]])
-                b = ti.Vector([wall[w, 2], wall[w, 3]])
+                a = ti.Vector([wall[w, W_X0], wall[w, W_Y0]])
+                b = ti.Vector([wall[w, W_X1], wall[w, W_Y1]])
                 t = b - a
                 tt = t.dot(t)
                 s = 0.0

@@ -9,8 +9,8 @@ Same-body Fluid and JWL neighbours repel through :func:`fluid_core_force`.
 """
 import taichi as ti
 
-from tdem.launch import cached
-from tdem.state import PROP_RADIUS
+from tdem.core.launch import cached
+from tdem.core.layout import PROP_RADIUS
 
 from ..contact_law import PAIR_TAIL, zero_history
 from ..materials import FLUID, JWL_TYPE, MAT_K, MAT_TYPE

@@ -20,8 +20,8 @@ date before the host reads or saves them.
 import taichi as ti
 
 from physics.materials import FLUID, JWL_SWELL, JWL_TYPE, MAT_CELLS, MAT_TYPE
-from tdem.launch import cached
-from tdem.neighbors import F_REBUILD
+from tdem.core.launch import cached
+from tdem.core.layout import F_REBUILD
 
 from .layout import (MAX_INCIDENT, P_BUILDS, P_BUILT, P_EPOCH, P_INC, P_NEED, P_NEW,
                      P_REBUILT, P_RECOUNT, P_SOFT, SCAN_BLOCK, inc_code)

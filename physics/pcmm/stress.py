@@ -11,7 +11,7 @@ forces of the step only (the blocks share :func:`viscous_stress`).
 """
 import taichi as ti
 
-from tdem.launch import cached
+from tdem.core.launch import cached
 
 from .. import fvm
 from ..materials import (FLUID, JWL_D, JWL_OMEGA, JWL_TYPE, MAT_B1, MAT_B2, MAT_EOS,

@@ -13,9 +13,9 @@ import math
 import numpy as np
 import taichi as ti
 
-from tdem import backend
-from tdem import state as schema
-from tdem.errors import CapacityError, InputError
+from tdem.core import backend
+from tdem.core.arrays import ndarray
+from tdem.core.errors import CapacityError, InputError
 
 from ..validate import positive
 from .layout import MAX_ELEMENTS
@@ -273,7 +273,7 @@ class ElementSystem:
         n, cap = self.n, self.capacity
         a = self.arrays
         if "pos" not in a:
-            a["pos"] = schema.ndarray(2, ti.f64, (n,))
+            a["pos"] = ndarray(2, ti.f64, (n,))
             a["rad"] = ti.ndarray(ti.f64, (n,))
             a["elem"] = ti.ndarray(ti.i32, (n, MAX_ELEMENTS, 2))
             a["ecnt"] = ti.ndarray(ti.i32, (n,))
