@@ -31,13 +31,11 @@ which is also its contact area. Only an edge the vertex can have entered through
 counts (the entrance rule of vertex–edge contacts): neither of the vertex's own
 two boundary edges may point into the other block across that edge's line,
 (x_nb − x_v)·n ≥ −``VERTEX_ENTRANCE``·|x_nb − x_v| for both neighbours x_nb
-(a tolerance of sin 5.7° for edges lying flat on each other). Without it a
-block stacked exactly on another (corners over corners), once shifted sideways
-by a hair, has its bottom corners crossing the side edges of the block below by
-less than they cross its top edge: they met those side edges, with horizontal
-normals, and the block fell through the one below, the stack's springs
-switching between the two edges of a corner at each step; a water surge made
-such stacks throw blocks up at metres per second. A vertex meets an edge up to
+(a tolerance of sin 5.7° for edges lying flat on each other). Without it the
+bottom corners of a block stacked corner over corner on another, shifted sideways
+by a hair, cross the side edges of the block below by less than they cross its top
+edge, and meet those side edges, with horizontal normals (what happened to such
+stacks: docs/pcmm.md, section Blocks and point–edge contacts). A vertex meets an edge up to
 ``VERTEX_END`` × its length past either end (closed ends, unlike particles): a
 block sitting corner over corner on another is held by the corner pairs of both
 blocks, and a sideways jiggle of a few µm does not drop all of them at once and

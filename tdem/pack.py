@@ -254,24 +254,18 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     The discs are listed as the lattices list theirs: in rows one mean diameter
     high, from the bottom up, x increasing along a row (see :func:`_in_rows`).
     Deterministic for a given ``seed``. ``target_fraction`` must lie in (0, 0.95];
-    random packings jam near 0.82–0.84 (R = 0.168–0.312 m in a 20 × 20 m square
-    jam at about 0.825, walls included), and a fraction that cannot be reached
-    raises :class:`tdem.InputError` after ``max_iter`` sweeps. That square at 0.8
-    holds about 1710 discs and takes a few seconds.
+    random packings jam near 0.82–0.84, and a fraction that cannot be reached
+    raises :class:`tdem.InputError` after ``max_iter`` sweeps.
 
     Denser than jamming, the discs must overlap: raise ``overlap_tol`` (the largest
     overlap left, relative to ``rmin``) with the fraction. PCMM particles may
     overlap (the elements carry their interaction, and the contact law counts from
     the initial overlap), and a PCMM body needs the density: at 0.8 the voids
-    between the discs leave holes in the element cover (in the 20 × 20 m square
-    about 4 % of the area, in chains that, depending on the seed, make the body up
-    to 14 % softer under its own weight and leave σ_yy at a point as low as 0.43 of
-    its elastic value). The same square at 0.89 with ``overlap_tol=0.7`` (1990–2003
-    discs by the seed, the count of Feng et al.'s random model; overlaps of
-    0.10–0.14 rmin on average, 0.31–0.52 rmin at the 99th percentile) packs in
-    1–5 s, and its elements cover 98.8–99.9 % of it (seeds 0–3). The relaxation
-    stops as soon as no overlap exceeds ``overlap_tol``, so a tighter one gives
-    more even overlaps where it can be reached (0.25 is reached for seed 0 only).
+    between the discs leave holes in the element cover that soften the body. The
+    relaxation stops as soon as no overlap exceeds ``overlap_tol``, so a tighter one
+    gives more even overlaps where it can be reached. Measurements (jamming, counts,
+    times, overlaps and element cover by seed): docs/pcmm.md, section Random
+    packings: measurements.
 
     ``edge_centres=True`` first lines the boundary with discs whose centres lie on
     it, as the boundary nodes of a mesh: a disc on every vertex, and along each
@@ -287,11 +281,8 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     for) then fills the holes that the PCMM element cover of that δ leaves
     (:func:`fill_holes`; with ``edge_centres`` also at the boundary, whose discs'
     elements reach it): a few pores of a random packing are wider than the
-    elements' rules bridge, and the body is softer and its stress off around them.
-    The 20 × 20 m square at 0.89 (``overlap_tol=0.7``, δ = 0.3 m, edge centres) had
-    its cover go from 98.84–99.98 % to 99.97–99.99 % (seeds 0–3) with 0–11 discs
-    added, and under its own weight its σ_yy at nine points of x = 10 m from up to
-    15 % to at most 1.6 % off the elastic solution (``cases/elastic_gravity.py``).
+    elements' rules bridge, and the body is softer and its stress off around them
+    (measurements: docs/pcmm.md, section Random packings: measurements).
     """
     rmin, rmax = _radius_range(rmin, rmax)
     overlap_tol = _positive("overlap_tol", overlap_tol)
@@ -691,12 +682,12 @@ def random3d(lower, upper, rmin, rmax, seed=0, target_fraction=0.5, overlap_tol=
     deterministic for a ``seed``.
 
     ``target_fraction`` must lie in (0, 0.62]: random packings of spheres jam near
-    0.64, less against walls. About 1,000 spheres (radii 4–6 mm in a 0.1 m cube)
-    pack in under a second up to 0.55 and in 2 s at 0.57; 0.58 is not reached in
-    the default sweeps (a fraction it cannot reach raises :class:`tdem.InputError`
-    after ``max_iter`` sweeps, naming the largest overlap left). Such a packing is
-    at rest, its spheres barely touching: settle it under gravity or compress it
-    for a bed (as PFC's ``ball distribute`` and Yade's ``makeCloud`` are used)."""
+    0.64, less against walls (how fast and how far it packs: docs/guide.md, section
+    Random packings of spheres: measurements); a fraction it cannot reach raises
+    :class:`tdem.InputError` after ``max_iter`` sweeps, naming the largest overlap
+    left. Such a packing is at rest, its spheres barely touching: settle it under
+    gravity or compress it for a bed (as PFC's ``ball distribute`` and Yade's
+    ``makeCloud`` are used)."""
     from scipy.spatial import cKDTree
     rmin, rmax = _radius_range(rmin, rmax)
     overlap_tol = _positive("overlap_tol", overlap_tol)

@@ -30,8 +30,8 @@ paths to second order. The prediction: |dφ| ≤ 1e-3, f″ changing by at most 
 over dφ (the cubic model holds), and f‴dφ²/2, what Newton's step leaves in f′,
 within the tolerance. A warm-started contact is then mostly done after its first
 evaluation even where its normal turns by more than the tolerance each step, as on
-flat faces, where f″ is large (1.17 evaluations per contact on the face-on bed of
-benchmarks/superellipse.py, 2.14 with the stop on f′ alone).
+flat faces, where f″ is large (evaluations per contact: benchmarks/RESULTS.md,
+section Superellipses beside discs).
 
 **Contact point and force.** The force acts at the midpoint c of P_i and P_j (the
 disc convention: R − δ/2 from each centre for discs), so that the tangential force
@@ -92,8 +92,9 @@ def curvature_radius(shp, c, s, u, cap):
 @ti.func
 def _root(x, k):
     """x^(1/k) for x > 0: by square roots where k is 2, 4 or 8 (the powers of n = 3, 4,
-    5, 8, 9; n = 4 is the common square-ish superellipse: 20 % more contacts per second
-    on benchmarks/superellipse.py), else by a logarithm and an exponential."""
+    5, 8, 9; n = 4 is the common square-ish superellipse; measurements:
+    benchmarks/RESULTS.md, section Superellipses beside discs), else by a logarithm
+    and an exponential."""
     out = 0.0
     if k == 2.0:
         out = ti.sqrt(x)

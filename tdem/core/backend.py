@@ -87,9 +87,9 @@ def init(arch=None, threads=None):
 def advanced_optimization(name):
     """Whether Taichi's advanced optimisation passes run: on the CPU yes; on CUDA no,
     since with them Taichi 1.7 builds kernels of shaped particles, PCMM bodies and
-    blocks that stop with CUDA_ERROR_MISALIGNED_ADDRESS (without them the DEM pack
-    runs as fast: 5.9e8 particle-steps/s at 1M discs on an H200, against 5.1e8 with
-    them). ``$TDEM_ADVANCED_OPTIMIZATION`` (1 or 0) overrides."""
+    blocks that stop with CUDA_ERROR_MISALIGNED_ADDRESS, and the DEM pack runs no
+    slower without them (measurements: benchmarks/RESULTS.md, section 7. CUDA).
+    ``$TDEM_ADVANCED_OPTIMIZATION`` (1 or 0) overrides."""
     env = os.environ.get("TDEM_ADVANCED_OPTIMIZATION", "")
     if env not in ("", "0", "1"):
         raise InputError(f"TDEM_ADVANCED_OPTIMIZATION must be 0 or 1, got {env!r}")
@@ -102,11 +102,9 @@ def cfg_optimization():
     """Whether Taichi's control-flow-graph pass (store forwarding and dead stores over
     a kernel's whole body) runs: off unless ``$TDEM_CFG_OPTIMIZATION=1``. Its cost
     grows faster than the size of a kernel, and the step kernels of shaped particles
-    are large: on 2 cores the first build of a model of ellipsoids took 135 s with it
-    and 18 s without, of a cube 143 s and 15 s, of superellipses 44 s and 6.5 s, of
-    spheres 46 s and 10 s. LLVM's own passes do most of its work afterwards: the
-    sphere and disc packs run as fast without it, ellipsoids and cubes 3–5 % slower
-    (``benchmarks/RESULTS.md``)."""
+    are large, while LLVM's own passes do most of its work afterwards. Measurements
+    (build times, run-time rates with and without it): benchmarks/RESULTS.md, section
+    Kernel builds: Taichi's control-flow-graph pass."""
     env = os.environ.get("TDEM_CFG_OPTIMIZATION", "")
     if env not in ("", "0", "1"):
         raise InputError(f"TDEM_CFG_OPTIMIZATION must be 0 or 1, got {env!r}")
@@ -115,10 +113,9 @@ def cfg_optimization():
 
 def opt_level():
     """Taichi's optimisation level of its own passes over a kernel (its default, 1),
-    or ``$TDEM_OPT_LEVEL`` (0 or 1). Level 0 builds kernels faster (the first step of
-    a bed of cubes: 17 s against 27 s on one core) and runs them up to about 10 %
-    slower (the 2D disc pack: 6.8e6 against 7.5e6 particle-steps/s on one core):
-    worth it where models are small and many, as in the test suite."""
+    or ``$TDEM_OPT_LEVEL`` (0 or 1). Level 0 builds kernels faster and runs them
+    somewhat slower: worth it where models are small and many, as in the test suite
+    (measurements: benchmarks/RESULTS.md, section Taichi's optimisation level 0)."""
     env = os.environ.get("TDEM_OPT_LEVEL", "")
     if env not in ("", "0", "1"):
         raise InputError(f"TDEM_OPT_LEVEL must be 0 or 1, got {env!r}")
@@ -157,7 +154,7 @@ def _same_settings(arch, threads):
 # dozen loops per step), more than a small model's loops take. Measured crossovers
 # on 2 threads (benchmarks/pack2d.py --rows, benchmarks/pcmm.py --side): a DEM pack
 # runs faster on one thread up to about 12,000 discs, a PCMM body up to about 2,000
-# particles (at 900, one thread is 1.2 times faster; at 8,100, two are 1.17 times).
+# particles (measurements: benchmarks/RESULTS.md, section 5. Small models).
 SERIAL_BELOW_DEM = 12000
 SERIAL_BELOW_ELEMENTS = 2000
 

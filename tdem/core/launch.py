@@ -1,20 +1,19 @@
 """Kernel launches that skip Taichi's per-call checks of the arguments.
 
 A Taichi kernel call from Python inspects every argument on every call (its kind,
-dtype and shape, to find the compiled variant) before it launches: about 5 µs per
-``ti.ndarray`` argument on the 2-core machine, so 130 µs for the 26 arrays of the
-PCMM element kernel, and about 0.75 ms per step for the dozen kernels of a PCMM
-step. For a model of a few hundred particles this is most of the step.
+dtype and shape, to find the compiled variant) before it launches. For a model of a
+few hundred particles this is most of the step (measurements: benchmarks/RESULTS.md,
+section 5. Small models).
 
 :func:`cached` wraps a kernel so that a call whose arguments are the same ndarray
 objects (and the same template values) as an earlier call reuses what that call
 found: the compiled kernel and a launch context holding the arrays (by their host
 addresses, the way Taichi passes numpy arrays; the CPU launcher reads them without
-rewriting the context), so a call sets only its scalar arguments and launches: about
-1 µs saved per array argument and call, 50 µs a step for the 45 arrays of the DEM
-step kernel. The cache holds weak references to the
-arrays (it keeps no memory alive; an entry whose arrays are gone is dropped when
-its key comes round again) and is cleared when Taichi is re-initialised.
+rewriting the context), so a call sets only its scalar arguments and launches
+(measurements: benchmarks/RESULTS.md, section Launch contexts kept, host views). The
+cache holds weak references to the arrays (it keeps no memory alive; an entry whose
+arrays are gone is dropped when its key comes round again) and is cleared when Taichi
+is re-initialised.
 
 The fast path is taken on the CPU only (the GPU path is Taichi's own call) and for
 kernels whose arguments are ndarrays, Python scalars and template values; anything
