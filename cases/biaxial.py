@@ -89,12 +89,12 @@ Decisions the paper leaves open
   0.25        20.9 ± 0.4 / 16.8      27.6 ± 2.0 / 21.4
   0.1         20.3 ± 0.7 / 16.1      27.0 ± 2.0 / 20.3
   0.05        19.3 ± 0.1 / 16.2      27.3 ± 1.8 / 20.0
+  0.025       19.7 ± 0.5 / 15.3      –
   ==========  =====================  =====================
 
-  Model 1's angles and both residuals have converged at 0.25 /s within the
-  specimens' spread; the peak without rolling resistance still falls by 1° from
-  0.1 to 0.05 /s (the paper preset's 0.1 /s reads it about 1° high). The quick
-  preset's 0.5 /s reads 2-4° high.
+  From 0.25 /s down the angles move by less than the specimens' spread (no
+  rolling resistance: 20.3, 19.3, 19.7° at 0.1, 0.05, 0.025 /s): the paper preset's
+  0.1 /s has converged. The quick preset's 0.5 /s reads 2-4° high.
 - Scatter: a single 1008-disc test varies by about ±1-2° in peak phi with the
   specimen (seed, confining stress) and, on several threads, from run to run
   (the wall forces are summed with atomic additions, whose order varies, and
@@ -119,15 +119,19 @@ quick (its measured time: --help): one 1008-disc specimen at --confining
 Model 1 at delta = 1.6) to 12 % axial strain at 0.5 /s (faster than quasi-static,
 see above). With --delta/--model only that test runs. paper: 0.1 /s to 20 %, the
 same four tests at 200 kPa plus the three Fig. 12 materials at 100 and 400 kPa
-(envelopes); about 30-40 minutes on 2 cores.
+(envelopes); about 10 minutes on one thread.
 
 Sweep (--sweep)
 ---------------
 The delta-phi study as independent tasks on Dask (``distributed.LocalCluster`` of
 --workers processes with one thread each, or an existing cluster with --scheduler
 ADDRESS; its workers must be able to import ``cases.biaxial``, e.g. started from the
-repository's root). One task prepares each specimen (one per confining stress) and
-returns its checkpoint; one task per test compresses a copy of it. paper: delta =
+repository's root). One task prepares each specimen (the layered specimen of a
+seed, consolidated to one confining stress) and returns its checkpoint; one task per
+test compresses a copy of it. ``--seeds``, ``--rates``, ``--stresses``,
+``--materials`` or ``--four-tests`` and ``--local-damping`` choose the tests; over
+several seeds or rates ``sweep.md`` adds the mean ± standard deviation of each test
+and of each specimen's envelope slopes. paper: delta =
 0, 0.1 ... 1.6 for Models 1 and 2 at 100, 200 and 400 kPa (99 tests, 0.1 /s at
 200 kPa to 20 %: several hours on 2 cores); quick: delta = 0, 0.4, 0.8, 1.6 for
 Model 1 and delta = 0.4 for Model 2 at the three stresses (15 tests, 0.5 /s at
