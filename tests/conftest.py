@@ -14,3 +14,11 @@ os.environ.setdefault("TDEM_SERIAL_BELOW", "0")
 # optimisation level 0 builds them about 40 % faster and runs them a little slower
 # (tdem.backend.opt_level); a run that sets TDEM_OPT_LEVEL itself keeps its choice.
 os.environ.setdefault("TDEM_OPT_LEVEL", "0")
+
+# pytest-xdist runs the suite in worker processes (the README's command: two on two
+# cores). A Taichi process takes every core by default, so each parallel loop would
+# wait on threads the other workers hold: give each worker its share of the cores
+# (one thread each for two workers on two cores: 4 test files 180 s -> 84 s).
+_workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "0") or 0)
+if _workers > 0:
+    os.environ.setdefault("TDEM_THREADS", str(max(1, (os.cpu_count() or 1) // _workers)))
