@@ -279,7 +279,11 @@ def test_layered_specimen_is_made_at_its_void_ratio_and_is_homogeneous(layered):
     bands = np.array(spec.history["band_void_ratio"])
     solid = 1.0 / (1.0 + bands)
     assert np.mean(solid) == pytest.approx(1.0 / (1.0 + e), rel=1e-3)
-    assert np.all(np.abs(bands - 0.25) < 0.08)     # (layers under two rows thick here)
+    # (layers under two rows thick here; the bands at the top and bottom walls hold
+    # the wall's extra void, a row of discs against a flat face: up to 0.33 measured
+    # at the top, the last layer pressed with no under-compaction)
+    assert np.all(np.abs(bands[1:-1] - 0.25) < 0.05)
+    assert np.all(np.abs(bands - 0.25) < 0.1)
 
 
 def test_layered_specimen_consolidates_denser_at_a_higher_stress(layered, tmp_path):
