@@ -22,3 +22,17 @@ os.environ.setdefault("TDEM_OPT_LEVEL", "0")
 _workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "0") or 0)
 if _workers > 0:
     os.environ.setdefault("TDEM_THREADS", str(max(1, (os.cpu_count() or 1) // _workers)))
+
+
+# The longest files first (seconds each with the cache empty, 2026-12-07), so that
+# the two workers do not end with one of them alone on a long file: pytest-xdist's
+# --dist loadfile hands out the files in the order collected.
+LONG_FILES = ("test_kernel_types.py", "test_voronoi_water.py", "test_biaxial.py",
+              "test_pcmm_cases.py", "test_readme_examples.py", "test_contact_burst.py",
+              "test_work_account.py", "test_cases_cli.py", "test_bearing_capacity.py",
+              "test_dam_break_case.py", "test_spheres_3d.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    rank = {name: k for k, name in enumerate(LONG_FILES)}
+    items.sort(key=lambda it: rank.get(os.path.basename(str(it.fspath)), len(rank)))
