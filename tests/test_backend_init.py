@@ -85,31 +85,25 @@ def test_bad_thread_counts_are_named():
         tdem.Simulation(threads="two")
 
 
-@pytest.mark.parametrize("env, expected", [(None, "False"), ("0", "False"), ("1", "True")])
-def test_control_flow_optimisation_off_unless_asked(env, expected):
-    # (off by default: it makes the first build of the step of shaped particles take
-    # minutes instead of seconds, tdem.backend.cfg_optimization)
-    r = _child("""
+# control-flow optimisation off by default (it makes the first build of the step of
+# shaped particles take minutes instead of seconds, tdem.backend.cfg_optimization);
+# Taichi's own optimisation level (1) unless $TDEM_OPT_LEVEL asks for 0 (faster builds)
+@pytest.mark.parametrize("name, attr, env, expected", [
+    ("TDEM_CFG_OPTIMIZATION", "cfg_optimization", None, "False"),
+    ("TDEM_CFG_OPTIMIZATION", "cfg_optimization", "0", "False"),
+    ("TDEM_CFG_OPTIMIZATION", "cfg_optimization", "1", "True"),
+    ("TDEM_OPT_LEVEL", "opt_level", None, "1"),
+    ("TDEM_OPT_LEVEL", "opt_level", "0", "0"),
+    ("TDEM_OPT_LEVEL", "opt_level", "1", "1")])
+def test_taichi_settings_from_the_environment(name, attr, env, expected):
+    r = _child(f"""
         import taichi as ti
         import tdem
         tdem.Simulation()
-        print("CFG", ti.lang.impl.current_cfg().cfg_optimization)
-        """, **({} if env is None else {"TDEM_CFG_OPTIMIZATION": env}))
+        print("SETTING", ti.lang.impl.current_cfg().{attr})
+        """, **({} if env is None else {name: env}))
     assert r.returncode == 0, r.stderr[-2000:]
-    assert f"CFG {expected}" in r.stdout
-
-
-@pytest.mark.parametrize("env, expected", [(None, "1"), ("0", "0"), ("1", "1")])
-def test_optimisation_level_from_the_environment(env, expected):
-    # Taichi's own default (1) unless $TDEM_OPT_LEVEL asks for 0 (faster builds)
-    r = _child("""
-        import taichi as ti
-        import tdem
-        tdem.Simulation()
-        print("OPT", ti.lang.impl.current_cfg().opt_level)
-        """, **({} if env is None else {"TDEM_OPT_LEVEL": env}))
-    assert r.returncode == 0, r.stderr[-2000:]
-    assert f"OPT {expected}" in r.stdout
+    assert f"SETTING {expected}" in r.stdout
 
 
 @pytest.mark.parametrize("name, value, message", [
