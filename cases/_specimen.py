@@ -300,14 +300,14 @@ class Specimen:
 
     def band_void_ratios(self, bands):
         """Void ratio of ``bands`` equal horizontal bands of the specimen, from the
-        disc areas inside each band (exact disc–band intersection)."""
+        disc areas inside each band (exact disc–box intersections, tdem.overlap_volume)."""
+        from tdem.overlap_volume import disc_box_area
         p = self.sim.particles.numpy()
         x, r = p["position"], p["radius"]
-        _, _, y0, y1 = self.box()
+        x0, x1, y0, y1 = self.box()
         edges = np.linspace(y0, y1, int(bands) + 1)
-        solid = np.zeros(int(bands))
-        for b in range(int(bands)):
-            solid[b] = np.sum(_disc_area_between(x[:, 1], r, edges[b], edges[b + 1]))
+        solid = np.array([np.sum(disc_box_area(x, r, (x0, lo), (x1, hi)))
+                          for lo, hi in zip(edges[:-1], edges[1:])])
         return (self.width * np.diff(edges) - solid) / solid
 
     def _mean_stresses(self, steps, samples=10):
@@ -373,18 +373,6 @@ class Specimen:
 
 
 _INWARD = {"left": (1.0, 0.0), "right": (-1.0, 0.0), "bottom": (0.0, 1.0), "top": (0.0, -1.0)}
-
-
-def _segment_area(r, h):
-    """Area of the part of a disc of radius ``r`` below a chord at height ``h`` above
-    its centre (h in [-r, r])."""
-    h = np.clip(h, -r, r)
-    return r * r * np.arccos(-h / r) + h * np.sqrt(np.maximum(r * r - h * h, 0.0))
-
-
-def _disc_area_between(yc, r, lo, hi):
-    """Area of each disc (centre height ``yc``, radius ``r``) between y = lo and hi."""
-    return _segment_area(r, hi - yc) - _segment_area(r, lo - yc)
 
 
 def _lattice(n, aspect, spacing, rng):
