@@ -296,6 +296,10 @@ class Specimen:
             if prev is not None and abs(s - prev) < tolerance * max(abs(s), 1e3):
                 return s
             prev = s
+        import warnings
+        warnings.warn(f"settle: the wall stress still changed by more than {tolerance:g} of "
+                      f"itself after {max_steps} steps (last {prev:.4g} Pa)", RuntimeWarning,
+                      stacklevel=2)
         return prev
 
     def band_void_ratios(self, bands):
