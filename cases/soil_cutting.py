@@ -12,15 +12,32 @@ scrapes some off the free face below it) are held where they are found, at each
 check of the bands (``data.fallen``): the model has no floor there, and one would
 otherwise fall until its speed is taken for an instability (a paper-preset run lost
 one 1 s into the cut this way).
-Blade (decided in the spec; the paper's Fig. 17 is not in the text): a steel plate
-(rho = 7800, E = 210 GPa, nu = 0.3) 0.6 m long and 0.04 m thick, inclined 60 deg to
-the horizontal, leaning back over the soil's left side; its cutting edge (the
-front lower corner) is 0.25 m below the soil surface, just left of the soil
-(a gap of 5 mm from the outermost particles' edge). Meshed with ``tdem.mesh.polygon``
-(element size 0.0113 m, about 400 triangles; the paper has 375). Soil-blade
-contacts are point-edge springs (``tdem.PointEdge``) with K_n = 10 MN/m per metre
-(the soil's E, not the default E of steel, which would cut the time step by
-a factor of 145) and phi = 20 deg, no cohesion.
+Blade. The paper's Fig. 17 is not in the text; its size and position are derived
+from the text (decided here, before the runs; 2026-12-07): a steel plate (rho =
+7800, E = 210 GPa, nu = 0.3) 0.04 m thick, inclined 60 deg to the horizontal (the
+spec's angle: the text gives none), leaning back over the soil's left side, its
+cutting edge (the front lower corner) just left of the soil (a gap of 5 mm from
+the outermost particles' edge):
+- cutting depth 0.28 m: P1 "declines to -0.27 m" at the end, after "some soil on
+  the top of the blade" has fallen down behind it, i.e. P1 comes to rest on the
+  floor the blade cut; a surface particle's centre (at the surface) resting on
+  that floor lies a radius above it, so the floor is 0.27 m + R = 0.28 m down
+  (R = 0.01 m; to within a radius: the floor is the tops of the particles the
+  edge passed over);
+- the front face's top 0.62 m above the surface: P1 "reaches the peak at 20 s,
+  with the peak value 0.62 m", riding up the blade's face in the soil it pushes,
+  and then falls; the highest it can ride before it falls over the blade is the
+  face's top;
+so the face is (0.28 + 0.62)/sin 60 deg = 1.04 m long. Meshed with
+``tdem.mesh.polygon`` at 0.0153 m: 406 triangles, the nearest the mesher comes to
+the paper's 375 (one size up it gives 272; the blade is rigid, so this only draws it).
+Before 2026-12-07 the blade was 0.6 m long and cut 0.25 m deep (its top 0.27 m
+above the surface): the soil it lifted fell over its top at 0.27 m, slid along
+the cut floor and off the model's open left end (P1-P3 ended near -1.05 m). ``run(blade={"angle": , "depth": , "top": })`` (``--blade-angle``,
+``--cut-depth``, ``--blade-top``) changes them; docs/cases.md has the
+sensitivity table. Soil-blade contacts are point-edge springs (``tdem.PointEdge``)
+with K_n = 10 MN/m per metre (the soil's E, not the default E of steel, which
+would cut the time step by a factor of 145) and phi = 20 deg, no cohesion.
 
 Stages: (1) settling: the blade at rest, local damping 0.7, ``settle`` seconds, so
 that the soil carries its weight before the cut starts (the gravity settlement
@@ -67,18 +84,39 @@ the force that keeps their velocity, N per metre; positive = the blade is pushed
 to the right, i.e. the soil resists with the opposite sign); bands: number of
 shear bands detected (below).
 
-Shear-band detection (a band of high plastic shear strain crossing the soil ahead
-of the blade, from the cutting edge up to the surface): take the particles whose
-current position lies in the horizontal strip halfway between the cutting depth
-and the surface (y in [0.80, 0.92] m) and ahead of the blade's cutting edge;
-bin them by x (bin = one particle diameter), take the largest plastic strain of
-each bin, smooth over three bins, and count the local maxima above the threshold
-``BAND_STRAIN`` (0.05) that are separated by at least 0.1 m. Each such crossing is
-one band; the spacing is the mean distance between neighbouring crossings. The
-count is re-evaluated through the run and the time at which it first reaches
-1, 2, 3 ... is the formation time of each band. A band that the blade has
-overrun or pushed into the heap in front of it leaves the strip and is no
-longer counted, so the maximum count over the run is reported beside the final one.
+Shear bands, as the paper counts them ("at time 2 s, the first shear band forms
+basically; at time 6 s, the second ...; at time 11 s, the third"): bands formed over
+the run, counted in the soil's initial coordinates, window by window
+(``bands_formed``; decided here, 2026-12-07). The plastic shear strain of every
+particle is kept at each check (``plastic_strain.npz``, with the positions). For
+each window of ``BAND_WINDOW`` (1 s paper-equivalent, 0.1 m of blade travel; the
+paper's bands form 4-5 s apart): the strain gained in the window by the particles
+that start in the middle third of the layer being cut and ahead of the cutting
+edge, its largest value per bin of initial x (one diameter), smoothed over three
+bins; a band is active where it has a peak of height and prominence of at least
+``BAND_INCREMENT`` (0.05, 18 x the soil's elastic shear strain at yield, c/G =
+0.0027), i.e. a band of shearing standing out of the soil around it; the soil the
+edge shears as it cuts, which falls off ahead of the edge without a second peak,
+is not a band. A band is formed when an active band lies at least
+``BAND_MIN_SEP`` (0.1 m) from every band formed before, in initial x (a band stays
+where it formed in the material). The spacing is the mean distance between
+neighbouring bands in initial x. summary.json keeps the count and times for
+thresholds 0.025-0.1 and windows 0.5-2 s (``data.bands_formed.sensitivity``) and,
+for the record, the earlier measure (bands crossing a fixed strip at one time,
+which counted the pile of cut soil crossing the strip: ``data.strip_crossings``).
+
+Free face: the soil's left side below the cut is a free face 0.72 m high, which
+must stand (Rankine's critical height of a vertical cut, 4c/(γ sqrt(K_a)) = 3.3 m,
+1.7 m without tension): ``free_face_stands`` checks that it moves less than 1 cm
+through the undamped run, from the base to ``FACE_BELOW`` (0.2 m) below the
+cutting edge (the edge scrapes the few particles just below it off the face; they
+are held where they fall below the base, ``data.fallen``). With the blade at rest the
+face stands (it moves by 1e-5 m in 1 s undamped: tests/test_soil_cutting.py); as
+the blade cuts, its edge presses on the soil below it and loads the face's crest
+(the quick preset: the face 0.5 m up moves out by 2 cm while the edge passes over
+it, and by 7 cm by the end, slowing). P4's bulk stress is also read 0.05, 0.2 and 0.3 m from
+both fixed sides (``data.P4_bulk_stress_end_Pa_by_distance_m``): the paper does
+not give P4's position, and near the fixed corner the stress changes fast with it.
 
 Outputs (``--out DIR``, default out/soil_cutting)
 ------------------------------------------------
@@ -102,25 +140,32 @@ W, H = 3.0, 1.0
 SOIL = dict(density=1750.0, young=10e6, poisson=0.35, cohesion=10e3, friction_angle=20.0,
             tensile_strength=3e3)
 STEEL = dict(density=7800.0, young=210e9, poisson=0.3)
-BLADE_LENGTH, BLADE_THICKNESS, BLADE_ANGLE = 0.6, 0.04, 60.0
-CUT_DEPTH = 0.25
+BLADE_THICKNESS, BLADE_ANGLE = 0.04, 60.0
+CUT_DEPTH = 0.28             # the cutting edge below the surface (docstring: P1's end)
+BLADE_TOP = 0.62             # the front face's top above the surface (P1's peak)
 BLADE_GAP = 0.005
 CONTACT_KN = 10e6            # point-edge K_n, N/m per metre (the soil's E)
 BAND_STRAIN = 0.05
 BAND_STRIP = (0.80, 0.92)
 BAND_MIN_SEP = 0.1
+BAND_INCREMENT = 0.05        # plastic shear strain gained within a window: a band active
+BAND_WINDOW = 1.0            # s paper-equivalent (0.1 m of blade travel)
+BAND_SENSITIVITY = {"threshold": (0.025, 0.05, 0.1), "window": (0.5, 1.0, 2.0)}
 MONITOR_X = {"P1": 0.75, "P2": 1.0, "P3": 1.25}
 P4_AT = (2.9, 0.1)
+P4_DISTANCES = (0.05, 0.2, 0.3)   # P4's bulk stress also read this far (m) from both fixed sides
+FACE_BOUND = 0.01            # m: the free face below the cut "stands" if it moves less
+FACE_BELOW = 0.2             # m: the face checked reaches this far below the cutting edge
 PAPER_SPEED = 0.1
 
 PRESETS = {
     "quick": dict(radius=0.025, elastic_blade=False, speed=0.5, duration=1.2, settle=0.2,
                   cut_damping=0.0, ramp=0.1,
-                  mesh_size=0.0113, vtu_interval=0.1, check_interval=0.02,
+                  mesh_size=0.0153, vtu_interval=0.1, check_interval=0.02,
                   snapshots=(0.4, 0.8, 1.2)),
     "paper": dict(radius=0.01, elastic_blade=False, speed=0.1, duration=27.5, settle=0.5,
                   cut_damping=0.0, ramp=0.1,
-                  mesh_size=0.0113, vtu_interval=0.5, check_interval=0.25,
+                  mesh_size=0.0153, vtu_interval=0.5, check_interval=0.25,
                   snapshots=(2.0, 6.0, 11.0, 20.0, 27.5)),
 }
 
@@ -132,14 +177,41 @@ PAPER = {
 
 
 # ------------------------------------------------------------------- model
-def blade_outline(radius):
+def rankine_height(tension=True):
+    """Rankine's critical height of an unsupported vertical cut in the soil:
+    4c/(γ sqrt(K_a)), K_a = tan²(45° − φ/2); without tension (a crack as deep as the
+    active zone's tension) half of it, 2c/(γ sqrt(K_a))."""
+    ka = math.tan(math.radians(45.0 - 0.5 * SOIL["friction_angle"])) ** 2
+    h = 4.0 * SOIL["cohesion"] / (SOIL["density"] * 9.81 * math.sqrt(ka))
+    return h if tension else 0.5 * h
+
+
+def blade_geometry(angle=BLADE_ANGLE, depth=CUT_DEPTH, top=BLADE_TOP):
+    """The blade's angle (degrees to the horizontal), cutting depth and the front
+    face's top above the surface (m), checked; returns (angle, depth, top, length of
+    the front face)."""
+    for name, v in (("angle", angle), ("depth", depth), ("top", top)):
+        if not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise tdem.InputError(f"blade {name} must be a number, got {v!r}")
+    if not 10.0 <= angle <= 90.0:
+        raise tdem.InputError(f"blade angle must be within 10-90 degrees, got {angle!r}")
+    if not 0.0 < depth < H:
+        raise tdem.InputError(f"blade depth must be within (0, {H}) m, got {depth!r}")
+    if not top > 0.0:
+        raise tdem.InputError(f"blade top must be above the surface (> 0 m), got {top!r}")
+    return float(angle), float(depth), float(top), (depth + top) / math.sin(math.radians(angle))
+
+
+def blade_outline(radius, angle=BLADE_ANGLE, depth=CUT_DEPTH, top=BLADE_TOP):
     """Corners of the blade plate (counter-clockwise): front lower corner (the
-    cutting edge), front upper, back upper, back lower."""
-    a = math.radians(BLADE_ANGLE)
+    cutting edge), front upper, back upper, back lower; and the unit vector along
+    the plate, up and back."""
+    angle, depth, top, length = blade_geometry(angle, depth, top)
+    a = math.radians(angle)
     u = np.array([-math.cos(a), math.sin(a)])        # along the plate, up and back
     n = np.array([math.sin(a), math.cos(a)])         # normal of the front face (to the soil)
-    tip = np.array([-radius - BLADE_GAP, H - CUT_DEPTH])
-    c = [tip, tip + BLADE_LENGTH * u, tip + BLADE_LENGTH * u - BLADE_THICKNESS * n,
+    tip = np.array([-radius - BLADE_GAP, H - depth])
+    c = [tip, tip + length * u, tip + length * u - BLADE_THICKNESS * n,
          tip - BLADE_THICKNESS * n]
     pts = np.array(c)
     area2 = np.sum(pts[:, 0] * np.roll(pts[:, 1], -1) - np.roll(pts[:, 0], -1) * pts[:, 1])
@@ -157,7 +229,7 @@ def build(cfg, arch=None, threads=None):
     fixed = np.union1d(sim.particles_in(ymax=0.5 * R), sim.particles_in(xmin=W - 0.5 * R))
     sim.fix_particles(fixed, vx=0.0, vy=0.0)
 
-    corners, u = blade_outline(R)
+    corners, u = blade_outline(R, **cfg.get("blade", {}))
     v, t = tdem.mesh.polygon(corners, cfg["mesh_size"])
     blade = sim.add_block(v, t, material=tdem.Elastic(density=STEEL["density"],
                                                       young=STEEL["young"],
@@ -187,7 +259,16 @@ def build(cfg, arch=None, threads=None):
     free = np.setdiff1d(np.arange(len(pos)), fixed)
     d = np.hypot(pos[free, 0] - P4_AT[0], pos[free, 1] - P4_AT[1])
     mon["P4"] = int(free[np.argmin(d)])
-    return dict(sim=sim, group=g, blade=blade, driven=driven, fixed=fixed, monitors=mon,
+    for dc in P4_DISTANCES:        # the same bulk stress at other distances from the corner
+        d = np.hypot(pos[free, 0] - (W - dc), pos[free, 1] - dc)
+        mon[f"P4_{dc:g}"] = int(free[np.argmin(d)])
+    # the free face left of the soil, from the base to FACE_BELOW under the cut (the
+    # edge scrapes the particles just below it off the face: they are not the face)
+    depth = blade_geometry(**cfg.get("blade", {}))[1]
+    face = np.flatnonzero((pos[:, 0] < 0.5 * R) & (pos[:, 1] > 1.5 * R)
+                          & (pos[:, 1] <= H - depth - FACE_BELOW + 1e-9))
+    return dict(sim=sim, group=g, blade=blade, driven=driven, fixed=fixed, monitors=mon, face=face,
+                depth=depth,
                 x0=np.asarray(pos, float), n=len(pos), triangles=np.asarray(t),
                 blade_corners=corners)
 
@@ -238,6 +319,64 @@ def detect_bands(p, tip_x, radius):
         if all(abs(xc[i] - xc[j]) >= BAND_MIN_SEP for j in kept):
             kept.append(i)
     return sorted(float(xc[i]) for i in kept)
+
+
+def bands_formed(times, x0, tip_x, eps, depth, radius, window, threshold=None,
+                 min_sep=BAND_MIN_SEP, edge_zone=0.0):
+    """Shear bands formed over the run, counted in the soil's initial coordinates,
+    window by window (module docstring). ``times`` (K,), ``tip_x`` (K,): the checks and
+    the cutting edge's x at each; ``x0`` (N, 2): the particles' initial positions;
+    ``eps`` (K, N): their plastic shear strain at each check; ``depth``: the cutting
+    depth; ``window``: the window's length (s). For each check k at least a window
+    after the first: the increment Δε over the window (from the last check at or
+    before t_k − window) of the particles that start in the middle third of the
+    layer being cut (y0 within [H − 2/3 depth, H − 1/3 depth]) and ahead of the edge
+    (x0 > tip_x[k]); its largest value per bin of x0 (one diameter), smoothed over
+    three bins; its peaks (``scipy.signal.find_peaks``) of height and prominence ≥
+    ``threshold`` (default :data:`BAND_INCREMENT`), at least ``min_sep`` apart and
+    more than ``edge_zone`` ahead of the edge (the soil the edge itself shears as it
+    cuts, which moves on with it) are the bands active in the window: a band stands
+    out of the strain around it by at least the threshold. A band is formed when
+    an active band lies at least ``min_sep`` from every band formed before (in x0:
+    a band stays where it formed in the material while the soil it crosses
+    is carried up the blade). Returns a dict: ``x0`` and ``time`` of each band
+    formed, in order, and ``active`` (K,): the number active in each window (0
+    before the first full window)."""
+    from scipy.signal import find_peaks
+    threshold = BAND_INCREMENT if threshold is None else threshold
+    times, tip_x, eps = np.asarray(times, float), np.asarray(tip_x, float), np.asarray(eps)
+    x0 = np.asarray(x0, float)
+    y_lo, y_hi = H - 2.0 * depth / 3.0, H - depth / 3.0
+    mid = (x0[:, 1] >= y_lo) & (x0[:, 1] <= y_hi)
+    b = 2.0 * radius
+    edges = np.arange(0.0, W + b, b)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    col = np.clip(np.digitize(x0[:, 0], edges) - 1, 0, len(centres) - 1)
+    formed_x, formed_t, active = [], [], np.zeros(len(times), int)
+    for k in range(len(times)):
+        j = int(np.searchsorted(times, times[k] - window + 1e-9, side="right")) - 1
+        if j < 0 or times[k] - times[0] < window - 1e-9:
+            continue
+        d = eps[k] - eps[j]
+        sel = mid & (x0[:, 0] > tip_x[k])
+        if not sel.any():
+            continue
+        # the profile over the bins ahead of the edge only, its ends padded with their
+        # own values (the soil behind the edge is cut: no band, and no false rise)
+        i0 = int(col[sel].min())
+        prof = np.zeros(len(centres) - i0)
+        np.maximum.at(prof, col[sel] - i0, d[sel])
+        smooth = np.convolve(np.pad(prof, 1, mode="edge"), np.ones(3) / 3.0, mode="valid")
+        peaks, _ = find_peaks(np.pad(smooth, 1, mode="edge"), height=threshold,
+                              prominence=threshold, distance=max(1, int(round(min_sep / b))))
+        kept = [i - 1 + i0 for i in peaks if centres[i - 1 + i0] > tip_x[k] + edge_zone]
+        active[k] = len(kept)
+        for i in sorted(kept):
+            xb = float(centres[i])
+            if all(abs(xb - f) >= min_sep for f in formed_x):
+                formed_x.append(xb)
+                formed_t.append(float(times[k]))
+    return {"x0": formed_x, "time": formed_t, "active": active}
 
 
 # ------------------------------------------------------------------- plots
@@ -340,12 +479,20 @@ def plot_profile(xc, prof, bands, png):
 
 # ------------------------------------------------------------------- the case
 def run(preset="quick", out=None, arch=None, threads=None, duration=None,
-        elastic_blade=None):
+        elastic_blade=None, blade=None):
     """Run the case; returns the summary dict (also written to ``out/summary.json``).
     ``elastic_blade``: True for the elastic steel blade driven at its back end, False
-    for the kinematic rigid blade (default: the preset's, rigid in both)."""
+    for the kinematic rigid blade (default: the preset's, rigid in both). ``blade``:
+    a dict with any of ``angle`` (degrees), ``depth`` and ``top`` (m) instead of the
+    derived geometry (module docstring)."""
     clock = common.Stopwatch()
     cfg = dict(PRESETS[preset])
+    blade = {k: v for k, v in (blade or {}).items() if v is not None}
+    unknown = set(blade) - {"angle", "depth", "top"}
+    if unknown:
+        raise tdem.InputError(f"blade: unknown keys {sorted(unknown)}; use angle, depth, top")
+    geometry = dict(zip(("angle", "depth", "top", "length"), blade_geometry(**blade)))
+    cfg["blade"] = blade
     if duration is not None:
         cfg["duration"] = float(duration)
     if elastic_blade is not None:
@@ -370,6 +517,12 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
         i = mon[k]
         sim.monitor(k, lambda s, i=i: float(cache()["position"][i, 1] - y_ref[i]), every=every)
     sim.monitor("P4", lambda s: float(bulk_stress(cache(), mon["P4"])), every=every)
+    for dc in P4_DISTANCES:
+        i4 = mon[f"P4_{dc:g}"]
+        sim.monitor(f"P4_{dc:g}", lambda s, i=i4: float(bulk_stress(cache(), i)), every=every)
+    x_ref = p["position"].copy()
+    face = m["face"]
+    face_u = []
     driven = m["driven"]
     sim.monitor("blade_Fx", lambda s: float(blade.nodes()["reaction"][driven, 0].sum()),
                 every=every)
@@ -382,7 +535,6 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
     # stage 2: cut
     tip0 = float(m["blade_corners"][0][0])
     band_t, band_n, band_x = [], [], []
-    first_time = {}
     snaps = []
     snap_times = [s for s in cfg["snapshots"] if s <= T + 1e-9]
     if not snap_times or snap_times[-1] < T - 1e-9:
@@ -390,6 +542,7 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
     checks = np.arange(cfg["check_interval"], T + 1e-9, cfg["check_interval"])
     stops = sorted(set(np.round(np.concatenate([checks, snap_times]), 9)))
     fallen = set()
+    strain_t, strain_eps, strain_x = [], [], []
     for tc in stops:
         sim.run(until=t0 + tc)
         p = sim.particles.numpy()
@@ -400,11 +553,14 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
             fallen.update(low)
         tip = tip0 + speed * (sim.time - t0)
         bands = detect_bands(p, tip, R)
+        face_u.append(float(np.linalg.norm(p["position"][face] - x_ref[face], axis=1).max())
+                      if len(face) else 0.0)
+        strain_t.append(sim.time - t0)
+        strain_eps.append(p["plastic_strain"].astype(np.float32))
+        strain_x.append(p["position"].astype(np.float32))
         band_t.append(sim.time - t0)
         band_n.append(len(bands))
         band_x.append(bands)
-        for c in range(1, len(bands) + 1):
-            first_time.setdefault(c, sim.time - t0)
         if any(abs(tc - s) < 1e-6 for s in snap_times):
             snaps.append({"t": sim.time - t0, "x": p["position"].copy(),
                           "eps": p["plastic_strain"].copy(),
@@ -418,14 +574,30 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
     hist = {k: (np.asarray(tv[0]) - t0, np.asarray(tv[1])) for k, tv in hist.items()}
     common.save_histories(out / "histories.h5", {
         "cut": hist, "bands": {"time": np.asarray(band_t), "count": np.asarray(band_n)}})
+    np.savez_compressed(out / "plastic_strain.npz", time=np.asarray(strain_t),
+                        x0=m["x0"], tip_x=tip0 + speed * np.asarray(strain_t),
+                        plastic_strain=np.asarray(strain_eps), position=np.asarray(strain_x))
     p = sim.particles.numpy()
     tip = tip0 + speed * (sim.time - t0)
     final_bands = detect_bands(p, tip, R)
     xc, prof = band_profile(p, tip, R)
-    # largest set of bands seen at any check (bands leave the strip when overrun)
+    # the earlier measure, kept for the record: crossings of a fixed strip at one time
     k_best = int(np.argmax(band_n)) if band_n else 0
     best = band_x[k_best] if band_x else []
-    spacing = float(np.mean(np.diff(best))) if len(best) >= 2 else float("nan")
+    depth = m["depth"]
+    formed = bands_formed(strain_t, m["x0"], tip0 + speed * np.asarray(strain_t),
+                          np.asarray(strain_eps), depth, R, BAND_WINDOW / equiv)
+    band_x0, band_times = formed["x0"], formed["time"]
+    order = np.argsort(band_x0)
+    spacing = (float(np.mean(np.diff(np.asarray(band_x0)[order]))) if len(band_x0) >= 2
+               else float("nan"))
+    sensitivity = {}
+    for thr in BAND_SENSITIVITY["threshold"]:
+        for win in BAND_SENSITIVITY["window"]:
+            f = bands_formed(strain_t, m["x0"], tip0 + speed * np.asarray(strain_t),
+                             np.asarray(strain_eps), depth, R, win / equiv, threshold=thr)
+            sensitivity[f"threshold {thr:g}, window {win:g} s"] = {
+                "x0_m": f["x0"], "time_paper_equivalent_s": [t * equiv for t in f["time"]]}
 
     tP1, vP1 = hist["P1"]
     k1 = int(np.argmax(vP1))
@@ -473,30 +645,42 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
                                   f"{t_eq:g} s: reported, not compared")
 
     paper_bands = [t for t in PAPER["band_times_s"] if common.reached(t_eq, t)]
-    times_eq = [first_time[c] * equiv for c in sorted(first_time)]
+    times_eq = [t * equiv for t in band_times]
     rise_ok, rise_note = when(PAPER["P1_rise_s"])
     peak_ok, peak_note = when(PAPER["P1_peak_time_s"])
     end_ok, end_note = when(27.5)
     two_bands = len(paper_bands) >= 2
+    how = (f"bands formed in the soil's initial coordinates, window by window "
+           f"({BAND_WINDOW:g} s paper-equivalent; a band: a peak of the plastic strain "
+           f"gained in the window, of height and prominence >= {BAND_INCREMENT:g}, across "
+           "the middle third of the layer being cut, ahead of the edge; module docstring)")
     checks = [
         common.check(
-            "bands_count", len(best), len(paper_bands), common.absolute(0), "",
-            f"most shear bands crossing the strip y in {BAND_STRIP} m at any check (at "
-            f"t = {band_t[k_best] if band_t else float('nan'):.2f} s, x = "
-            f"{', '.join(f'{x:.2f}' for x in best)} m); paper: bands at about 2, 6 and 11 s "
-            f"paper-equivalent, {len(paper_bands)} of them by the end of this run"),
+            "bands_count", len(band_x0), len(paper_bands), common.absolute(0), "",
+            f"{how}: formed at x0 = {', '.join(f'{x:.2f}' for x in band_x0) or 'none'} m; "
+            f"paper: bands at about 2, 6 and 11 s paper-equivalent, {len(paper_bands)} of "
+            "them by the end of this run"),
         common.check(
             "band_spacing", spacing, PAPER["band_spacing_m"],
             common.absolute(2 * R) if two_bands else None, "m",
-            "mean distance between neighbouring crossings; within one particle diameter "
-            "(the detection's bin)" + ("" if two_bands else
-                                       "; the paper's second band is beyond this run: "
-                                       "reported, not compared")),
+            "mean distance between neighbouring bands in the soil's initial coordinates; "
+            "within one particle diameter (the detection's bin)"
+            + ("" if two_bands else "; the paper's second band is beyond this run: "
+                                    "reported, not compared")),
         common.check(
             "band_formation_times", times_eq[:len(paper_bands)] if paper_bands else times_eq,
             paper_bands or None, common.absolute(1.0) if paper_bands else None, "s",
-            "paper-equivalent time at which the count first reached 1, 2, ...; the paper's "
-            "'about' read as within 1 s; " + note_eq),
+            "paper-equivalent time at which each band formed (the end of the first window "
+            "it is active in); the paper's 'about' read as within 1 s; " + note_eq),
+        common.check(
+            "free_face_stands", float(max(face_u)) if face_u else None, None,
+            common.between(max=FACE_BOUND), "m",
+            "largest displacement of the soil's free left face over the run (undamped), "
+            f"from the base to {FACE_BELOW:g} m below the cutting edge (the edge scrapes "
+            "the particles just below it off the face): it stands if it moves less than 1 cm, 20 x its settlement under "
+            "gravity; Rankine's critical height of a vertical cut in this soil is "
+            f"{rankine_height():.1f} m ({rankine_height(tension=False):.1f} m without "
+            "tension), above the face's 0.72 m"),
         common.check(
             "P1_rise_time", float(tP1[rise[0]]) * equiv if len(rise) else None,
             PAPER["P1_rise_s"], common.absolute(1.0) if rise_ok else None, "s",
@@ -520,6 +704,10 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
     ]
     data = {
         "model": {"particles": m["n"], "radius_m": R, "blade_triangles": len(m["triangles"]),
+                  "blade_geometry": {"angle_deg": geometry["angle"],
+                                     "cut_depth_m": geometry["depth"],
+                                     "top_above_surface_m": geometry["top"],
+                                     "face_length_m": geometry["length"]},
                   "blade": "elastic, left-side nodes driven" if cfg["elastic_blade"]
                   else "kinematic rigid (all nodes driven)",
                   "blade_speed_m_s": speed, "cut_duration_s": T, "blade_travel_m": travel,
@@ -528,18 +716,26 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
                   "steps": int(round((sim.time) / dt))},
         "fallen": {"count": len(fallen), "note": "particles that fell below the soil's base "
                    "(off the free face under the blade), held where found"},
-        "bands_final_count": len(final_bands),
-        "band_formation_times_s": [first_time.get(c) for c in sorted(first_time)],
+        "bands_formed": {"x0_m": band_x0, "time_s": band_times,
+                         "time_paper_equivalent_s": times_eq,
+                         "active_per_window": formed["active"].tolist(),
+                         "sensitivity": sensitivity},
+        "strip_crossings": {"note": "the earlier measure: shear bands crossing the strip y "
+                            f"in {list(BAND_STRIP)} m at one time (counts the pile of cut "
+                            "soil crossing the strip too)", "most": len(best),
+                            "at_s": band_t[k_best] if band_t else None,
+                            "final": len(final_bands)},
+        "P4_bulk_stress_end_Pa_by_distance_m": {
+            **{f"{dc:g}": float(hist[f"P4_{dc:g}"][1][-1]) for dc in P4_DISTANCES},
+            "0.1": float(vP4[-1])},
+        "free_face_max_displacement_m": float(max(face_u)) if face_u else None,
         "P1_start_m": start_P1,
         "P4_initial_bulk_stress_Pa": float(vP4[0]),
         "blade_Fx_final_N_per_m": float(vF[-1]),
         "blade_Fx_max_abs_N_per_m": float(np.max(np.abs(vF))),
         "speed_end_m_s": {"max": float(speeds.max()), "median": float(np.median(speeds)),
                           "above_2x_blade": int(np.sum(speeds > 2.0 * speed))},
-        "band_detection": ("crossings of the strip y in [0.80, 0.92] m ahead of the cutting "
-                           "edge: max plastic strain per x-bin of one diameter, smoothed over "
-                           f"3 bins, local maxima >= {BAND_STRAIN} at least {BAND_MIN_SEP} m "
-                           "apart"),
+        "band_detection": how,
         "band_history": {"time_s": band_t, "count": band_n},
         "runtime_s": {"settle": settle_s, "cut": cut_s},
     }
@@ -564,12 +760,22 @@ def _extra(p):
                    help="the elastic steel blade driven at its back end (its stiffness "
                         "sets the time step: 165 times as many steps at R = 0.01 m) "
                         "instead of the kinematic rigid blade")
+    p.add_argument("--blade-angle", type=float, default=None, metavar="DEG",
+                   help=f"the blade's angle to the horizontal (default {BLADE_ANGLE:g})")
+    p.add_argument("--cut-depth", type=float, default=None, metavar="M",
+                   help=f"the cutting edge's depth below the surface (default {CUT_DEPTH:g})")
+    p.add_argument("--blade-top", type=float, default=None, metavar="M",
+                   help="the blade face's top above the surface (default "
+                        f"{BLADE_TOP:g})")
+    p.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="seconds of cutting (default: the preset's)")
 
 
 def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
     s = run(args.preset, out, arch=args.arch, threads=args.threads,
-            elastic_blade=True if args.elastic_blade else None)
+            duration=args.duration, elastic_blade=True if args.elastic_blade else None,
+            blade={"angle": args.blade_angle, "depth": args.cut_depth, "top": args.blade_top})
     common.print_checks(s)
     print(f"summary: {out / 'summary.json'}")
     return 0
