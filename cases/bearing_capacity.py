@@ -124,9 +124,9 @@ def domain(phi_deg):
     return (4.0 * B_HALF, 2.0 * B_HALF) if phi_deg == 0 else (8.0 * B_HALF, 3.0 * B_HALF)
 
 
-def spec(kind, n, W, H):
+def spec(kind, n, W, H, seed=0):
     """The model spec (cases._pcmm) of ``kind`` with n cells or spacings under the
-    half-footing (h = b/n)."""
+    half-footing (h = b/n); ``seed``: the random packing's."""
     h = B_HALF / n
     if kind in ("fvm", "fvm_cross"):
         return {"kind": "fvm", "cells": (int(round(W / h)), int(round(H / h))),
@@ -141,21 +141,22 @@ def spec(kind, n, W, H):
         # with the holes of the element cover filled, as the other PCMM cases
         return {"kind": "random", "rmin": 0.3 * h, "rmax": 0.7 * h, "tolerance": 0.5 * h,
                 "fraction": 0.86, "overlap_tol": 0.7, "fill_holes": True,
-                "edge_centres": True}
+                "edge_centres": True, "seed": int(seed)}
     raise ValueError(f"kind {kind!r}: choose fvm, fvm_cross, regular, cross or random")
 
 
 def footing(kind, n, phi_deg=0.0, speed=SPEED, s_end=S_END, sim_kwargs=None, mixed=True,
-            progress=False):
+            progress=False, seed=0):
     """Build and run one footing; returns a dict with the model, the load–settlement
     curve (``s_over_b``, ``q_over_c``), the limit load and the flatness.
-    ``mixed=False`` runs the elements' plain update (for comparison)."""
+    ``mixed=False`` runs the elements' plain update (for comparison); ``seed``: the
+    random packing's."""
     W, H = domain(phi_deg)
     kw = dict(gravity=(0.0, 0.0), local_damping=0.7, progress=progress,
               mixed_discretization=mixed)
     kw.update(sim_kwargs or {})
     name = f"{kind}" if kind != "fvm_cross" else "fvm_cross"
-    m = _pcmm.Model(name, spec(kind, n, W, H), W, H, soil(phi_deg), kw)
+    m = _pcmm.Model(name, spec(kind, n, W, H, seed), W, H, soil(phi_deg), kw)
     sim = m.sim
     x = m.x0
     tol = 1e-6 * W
