@@ -100,6 +100,9 @@ PRESETS = {
 }
 
 
+LABELS_KINDS = ("fvm", "fvm_cross", "regular", "cross", "random")
+
+
 def prandtl(phi_deg):
     """Prandtl's N_c for the friction angle φ (degrees): 2 + π at φ = 0,
     (N_q − 1)·cot φ with N_q = e^{π tan φ}·tan²(45° + φ/2) above."""
@@ -232,32 +235,56 @@ def footing(kind, n, phi_deg=0.0, speed=SPEED, s_end=S_END, sim_kwargs=None, mix
             "count": m.count}
 
 
-def run(preset="quick", out=None, models=None, arch=None, threads=None):
-    """Run the case; returns the summary dict (also written to out/summary.json)."""
-    out = common.output_dir(CASE, out)
-    watch = common.Stopwatch()
+def run(preset="quick", out=None, models=None, arch=None, threads=None, seeds=(0,)):
+    """Run the case; returns the summary dict (also written to out/summary.json).
+    ``seeds``: the random packing is run once per seed at each resolution, and its
+    limit load is the mean over them (the spread beside it)."""
     p = PRESETS[preset]
     kinds = list(p["models"] if models is None else models)
+    bad = [k for k in kinds if k not in LABELS_KINDS]
+    if bad:
+        raise tdem.InputError(f"models: unknown {bad}; choose from {list(LABELS_KINDS)}")
+    seeds = list(seeds)
+    if (not seeds or len(set(seeds)) != len(seeds)
+            or not all(isinstance(x, int) and not isinstance(x, bool) for x in seeds)):
+        raise tdem.InputError(f"seeds must be distinct integers, got {seeds!r}")
+    out = common.output_dir(CASE, out)
+    watch = common.Stopwatch()
     sk = dict(arch=arch, threads=threads)
     nc0, nc20 = prandtl(0.0), prandtl(20.0)
-    runs, checks, data, hist = [], [], {"N_c": {"0": nc0, "20": nc20}, "runs": {}}, {}
+    runs, checks, data, hist = [], [], {"N_c": {"0": nc0, "20": nc20}, "runs": {},
+                                        "seeds": seeds}, {}
     for kind in kinds:
         mine = []
         for n in p["resolutions"]:
-            r = footing(kind, n, 0.0, sim_kwargs=sk)
-            mine.append(r)
-            runs.append(r)
-            print(f"  {kind} n = {n}: q/c = {r['limit']:.3f} (N_c {nc0:.3f}), rise "
-                  f"{100 * r['rise']:.1f} %, {r['steps']} steps, {r['run_s']:.0f} s", flush=True)
+            group = []
+            for seed in (seeds if kind == "random" else (0,)):
+                r = footing(kind, n, 0.0, sim_kwargs=sk, seed=seed)
+                r["seed"] = seed
+                group.append(r)
+                runs.append(r)
+                print(f"  {kind} n = {n}" + (f", seed {seed}" if kind == "random" else "")
+                      + f": q/c = {r['limit']:.3f} (N_c {nc0:.3f}), rise "
+                      f"{100 * r['rise']:.1f} %, {r['steps']} steps, {r['run_s']:.0f} s",
+                      flush=True)
+            lims = np.array([r["limit"] for r in group])
+            rises = np.array([r["rise"] for r in group])
+            mine.append({"n": n, "limit": float(lims.mean()), "rise": float(rises.mean()),
+                         "sd": float(lims.std(ddof=1)) if len(lims) > 1 else None,
+                         "count": len(lims)})
         finest = mine[-1]["n"]
         for r in mine:
             label = f"{_pcmm.LABELS.get(kind, kind)}, {r['n']} per half-width"
+            over = (f" (mean of {r['count']} seeds, sd {r['sd']:.3f})" if r["count"] > 1
+                    else "")
             tol = common.rel(LIMIT_TOL) if r["n"] == finest else None
             checks.append(common.check(f"{kind}.{r['n']}.limit", r["limit"], nc0, tol, "q/c",
-                                       f"{label}: mean q/c over s/b 0.08–0.10; target 2 + π"))
+                                       f"{label}: mean q/c over s/b 0.08–0.10{over}; "
+                                       "target 2 + π"))
             checks.append(common.check(f"{kind}.{r['n']}.flat", r["rise"], None,
                                        common.between(min=-FLAT_TOL, max=FLAT_TOL), "",
-                                       f"{label}: (q(0.10 b) − q(0.07 b))/q, within ±3 %"))
+                                       f"{label}: (q(0.10 b) − q(0.07 b))/q{over}, within "
+                                       "±3 %"))
         lims = [r["limit"] for r in mine]
         falls = all(lims[k + 1] <= lims[k] * 1.01 for k in range(len(lims) - 1))
         conv = float(falls and min(lims) >= FLOOR * nc0)
@@ -265,6 +292,9 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None):
                                    f"{_pcmm.LABELS.get(kind, kind)}: limit loads "
                                    f"{', '.join(f'{v:.3f}' for v in lims)} fall with the "
                                    f"resolution (1 % slack) and stay above {FLOOR} N_c"))
+        if kind == "random" and len(seeds) > 1:
+            data["random_seeds"] = {str(r["n"]): {"mean": r["limit"], "sd": r["sd"]}
+                                    for r in mine}
     for kind, n in p["phi20"]:
         if kind not in kinds:
             continue
@@ -277,7 +307,8 @@ def run(preset="quick", out=None, models=None, arch=None, threads=None):
                                    "φ = ψ = 20°: mean q/c over s/b 0.08–0.10; target "
                                    "(N_q − 1) cot φ"))
     for r in runs:
-        key = f"phi{int(r['phi'])}.{r['kind']}.{r['n']}"
+        key = f"phi{int(r['phi'])}.{r['kind']}.{r['n']}" + (
+            f".seed{r['seed']}" if r["kind"] == "random" and len(seeds) > 1 else "")
         data["runs"][key] = {"limit": r["limit"], "rise": r["rise"], "b": r["b"], "h": r["h"],
                              "steps": r["steps"], "dt": r["dt"], "run_s": r["run_s"],
                              "count": r["count"]}
@@ -317,9 +348,16 @@ def plots(runs, out, nc0, nc20):
             kinds.append(r["kind"])
     for k in kinds:
         mine = [r for r in runs if r["phi"] == 0 and r["kind"] == k]
-        ax.plot([r["n"] for r in mine], [r["limit"] for r in mine],
-                marker=_pcmm.MARKERS.get(k, "o"), mfc="none", color=_pcmm.COLORS.get(k, "k"),
-                label=_pcmm.LABELS.get(k, k))
+        ns = sorted({r["n"] for r in mine})
+        by_n = [np.array([r["limit"] for r in mine if r["n"] == n]) for n in ns]
+        mean = np.array([v.mean() for v in by_n])
+        many = max(len(v) for v in by_n) > 1
+        ax.errorbar(ns, mean, yerr=[mean - [v.min() for v in by_n],
+                                    [v.max() for v in by_n] - mean] if many else None,
+                    marker=_pcmm.MARKERS.get(k, "o"), mfc="none", capsize=3,
+                    color=_pcmm.COLORS.get(k, "k"),
+                    label=_pcmm.LABELS.get(k, k) + (" (mean, range over seeds)" if many
+                                                    else ""))
     ax.axhline(nc0, color="k", ls="--", lw=1, label="2 + π")
     ax.axhspan(nc0, nc0 * (1 + LIMIT_TOL), color="0.85", label="within 5 %")
     ax.set_xscale("log")
@@ -362,8 +400,21 @@ def plots(runs, out, nc0, nc20):
     common.save(fig, out / "mechanism.png")
 
 
+def _extra(p):
+    p.add_argument("--models", nargs="+", choices=list(LABELS_KINDS), default=None,
+                   help="which models to run (default: the preset's)")
+    p.add_argument("--seeds", nargs="+", type=int, default=[0], metavar="SEED",
+                   help="the random packing once per seed at each resolution; its limit "
+                        "load is the mean over them (default: 0)")
+
+
 def main(argv=None):
-    return _pcmm.main(CASE, run, __doc__, argv)
+    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
+    s = run(args.preset, out, models=args.models, arch=args.arch, threads=args.threads,
+            seeds=args.seeds)
+    common.print_checks(s)
+    print(f"summary: {out / 'summary.json'}")
+    return 0
 
 
 if __name__ == "__main__":

@@ -55,3 +55,15 @@ def test_finest_resolution_within_five_percent(kind):
     r = bc.footing(kind, 20)
     assert r["limit"] == pytest.approx(NC0, rel=0.05)
     assert r["limit"] > 0.97 * NC0
+
+
+@pytest.mark.parametrize("kw,word", [({"models": ["hexagon"]}, "models"),
+                                     ({"seeds": [1, 1]}, "seeds"),
+                                     ({"seeds": []}, "seeds"),
+                                     ({"seeds": [0.5]}, "seeds")])
+def test_bad_models_and_seeds_are_named_before_anything_is_built(tmp_path, kw, word):
+    import tdem
+    out = tmp_path / "bc"
+    with pytest.raises(tdem.InputError, match=word):
+        bc.run("quick", out=out, **kw)
+    assert not out.exists()
