@@ -23,6 +23,7 @@ from . import mesh, pack, surfaces
 from .plot import plot_history
 from .errors import CapacityError, InputError, InstabilityError
 from .pack import random_orientations
+from .gradings import Grading, grading
 from .simulation import Block, Mesh, ParticleGroup, Simulation, Wall
 from .ensemble import Results as _EnsembleResults, ensemble, grid as _grid
 
@@ -36,4 +37,4 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
-           "ensemble"]
+           "ensemble", "grading", "Grading"]

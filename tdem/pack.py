@@ -233,10 +233,12 @@ def _pairs(x, cut, h):
     return i, j
 
 
-def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 0.0),
-           polygon=None, overlap_tol=1e-3, max_iter=20000, edge_centres=False,
-           pcmm_tolerance=None):
-    """Dense random packing of discs with radii uniform in [rmin, rmax].
+def random(width, height, rmin=None, rmax=None, seed=0, target_fraction=0.8,
+           origin=(0.0, 0.0), polygon=None, overlap_tol=1e-3, max_iter=20000,
+           edge_centres=False, pcmm_tolerance=None, grading=None):
+    """Dense random packing of discs with radii uniform in [rmin, rmax], or drawn
+    from ``grading`` (a :func:`tdem.grading`: its mass curve for discs of equal
+    thickness; rmin and rmax are then its range and are left out).
 
     The region is the rectangle ``origin + [0, width] × [0, height]``, or the
     simple polygon ``polygon`` (M, 2) (then width and height must be None). Every
@@ -284,7 +286,7 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
     elements' rules bridge, and the body is softer and its stress off around them
     (measurements: docs/pcmm.md, section Random packings: measurements).
     """
-    rmin, rmax = _radius_range(rmin, rmax)
+    rmin, rmax, draw = _radii_source(rmin, rmax, grading, 2)
     overlap_tol = _positive("overlap_tol", overlap_tol)
     if pcmm_tolerance is not None:
         pcmm_tolerance = _nonnegative("pcmm_tolerance", pcmm_tolerance)
@@ -311,10 +313,10 @@ def random(width, height, rmin, rmax, seed=0, target_fraction=0.8, origin=(0.0, 
 
     # radii until the target area is reached
     mean_area = math.pi * (rmin * rmin + rmin * rmax + rmax * rmax) / 3.0
-    est = int(target_area / mean_area * 1.1) + 16
-    r = rng.uniform(rmin, rmax, est)
+    est = min(int(target_area / mean_area * 1.1) + 16, 1_000_000)
+    r = draw(rng, est)
     while np.sum(np.pi * r * r) < target_area:
-        r = np.concatenate([r, rng.uniform(rmin, rmax, est)])
+        r = np.concatenate([r, draw(rng, est)])
     n = int(np.searchsorted(np.cumsum(np.pi * r * r), target_area)) + 1
     r = r[:n]
 
@@ -404,6 +406,24 @@ def _unreached(target_fraction, overlap_tol, max_iter, worst):
                       f"overlaps of at most overlap_tol={overlap_tol!r} x rmin in {max_iter} "
                       f"sweeps (largest overlap {worst:.3g} m); lower it or raise "
                       f"overlap_tol")
+
+
+def _radii_source(rmin, rmax, grading, dim):
+    """(rmin, rmax, draw(rng, n)) of a packer: radii uniform in [rmin, rmax], or
+    drawn from ``grading`` (its range then rmin and rmax, which must be left out)."""
+    if grading is None:
+        if rmin is None or rmax is None:
+            raise InputError("give rmin and rmax, or a grading (tdem.grading), got "
+                             f"rmin={rmin!r}, rmax={rmax!r}, grading=None")
+        rmin, rmax = _radius_range(rmin, rmax)
+        return rmin, rmax, lambda rng, n: rng.uniform(rmin, rmax, n)
+    from .gradings import Grading
+    if not isinstance(grading, Grading):
+        raise InputError(f"grading must be a tdem.grading(...), got {grading!r}")
+    if rmin is not None or rmax is not None:
+        raise InputError(f"give rmin and rmax or a grading, not both: got rmin={rmin!r}, "
+                         f"rmax={rmax!r} with {grading!r}")
+    return grading.r_min, grading.r_max, lambda rng, n: grading.sample(n, rng=rng, dim=dim)
 
 
 def _radius_range(rmin, rmax):
@@ -671,9 +691,10 @@ def lattice3d(lower, upper, radius, kind="fcc"):
     return pts[np.all(pts <= hi + 1e-12 * cell, axis=1)]
 
 
-def random3d(lower, upper, rmin, rmax, seed=0, target_fraction=0.5, overlap_tol=1e-3,
-             max_iter=20000):
-    """Random packing of spheres with radii uniform in [rmin, rmax] in the box
+def random3d(lower, upper, rmin=None, rmax=None, seed=0, target_fraction=0.5,
+             overlap_tol=1e-3, max_iter=20000, grading=None):
+    """Random packing of spheres with radii uniform in [rmin, rmax] (or drawn from
+    ``grading``, a :func:`tdem.grading`, by its mass curve; rmin and rmax left out) in the box
     [lower, upper] (3D), as :func:`random` packs discs: radii drawn until the spheres'
     volume reaches ``target_fraction`` × the box's, centres uniform in the box, the
     radii grown from half size while overlaps (pairs, and spheres against the box's
@@ -689,7 +710,7 @@ def random3d(lower, upper, rmin, rmax, seed=0, target_fraction=0.5, overlap_tol=
     gravity or compress it for a bed (as PFC's ``ball distribute`` and Yade's
     ``makeCloud`` are used)."""
     from scipy.spatial import cKDTree
-    rmin, rmax = _radius_range(rmin, rmax)
+    rmin, rmax, draw = _radii_source(rmin, rmax, grading, 3)
     overlap_tol = _positive("overlap_tol", overlap_tol)
     tf = float(target_fraction)
     if not (0.0 < tf <= 0.62):
@@ -708,10 +729,10 @@ def random3d(lower, upper, rmin, rmax, seed=0, target_fraction=0.5, overlap_tol=
     sphere = 4.0 / 3.0 * math.pi
     mean_vol = sphere * (rmax ** 4 - rmin ** 4) / (4.0 * (rmax - rmin)) if rmax > rmin \
         else sphere * rmin ** 3
-    est = int(tf * volume / mean_vol * 1.1) + 16
-    r = rng.uniform(rmin, rmax, est)
+    est = min(int(tf * volume / mean_vol * 1.1) + 16, 1_000_000)
+    r = draw(rng, est)
     while np.sum(sphere * r ** 3) < tf * volume:
-        r = np.concatenate([r, rng.uniform(rmin, rmax, est)])
+        r = np.concatenate([r, draw(rng, est)])
     n = int(np.searchsorted(np.cumsum(sphere * r ** 3), tf * volume)) + 1
     r = r[:n]
     x = rng.uniform(lo + rmin, hi - rmin, (n, 3))
