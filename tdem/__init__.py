@@ -19,7 +19,7 @@ from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 from physics.polyhedron import Polyhedron
 from physics.shapes import Ellipsoid, Superellipse
 
-from . import mesh, pack, surfaces
+from . import mesh, motion, pack, surfaces
 from .plot import plot_history
 from .errors import CapacityError, InputError, InstabilityError
 from .pack import random_orientations
@@ -37,4 +37,4 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
-           "ensemble", "grading", "Grading"]
+           "ensemble", "grading", "Grading", "motion"]

@@ -252,6 +252,48 @@ def _fix_value(name, v, ids):
     return a
 
 
+def _motion_part(name, v, n):
+    """A motion's part: None (not prescribed), a function of time (checked when it is
+    called, every step), or a constant of ``n`` finite numbers (returned as an array)."""
+    if v is None or callable(v):
+        return v
+    try:
+        a = np.asarray(v, dtype=float).reshape(n)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or not np.isfinite(a).all():
+        raise InputError(f"{name} must be None, {n} finite number"
+                         + ("s" if n > 1 else "") + f" or a function of time, got {v!r}")
+    return a
+
+
+def _set_motion(handle, kind, first, count, velocity, angular_velocity, center, dim):
+    """Wall.motion / Mesh.motion: constants set now, functions of time registered for
+    the runner (:meth:`tdem.runner.Runner._apply_motions`)."""
+    sim = handle._sim
+    key = (kind, handle.index)
+    if kind == "mesh" and handle.index in sim._mesh_servo or (
+            kind == "wall" and handle._row()[stepk.W_SERVO_K] != 0.0):
+        raise InputError(f"{kind} {handle.index} is servo-controlled: switch the servo off "
+                         "(servo()) before giving it a motion")
+    vel = _motion_part("velocity", velocity, dim)
+    ang = _motion_part("angular_velocity", angular_velocity, 1 if dim == 2 else 3)
+    if center is not None:
+        c = _vector2("center", center, dim)
+        handle._set_center(c)
+    # constants (or nothing: at rest) now, functions from the next step on
+    handle.velocity = np.zeros(dim) if vel is None or callable(vel) else vel
+    w0 = np.zeros(1 if dim == 2 else 3) if ang is None or callable(ang) else ang
+    handle.angular_velocity = float(w0[0]) if dim == 2 else w0
+    fn_v = vel if callable(vel) else None
+    fn_w = ang if callable(ang) else None
+    if fn_v is None and fn_w is None:
+        sim._motions.pop(key, None)
+    else:
+        sim._motions[key] = (first, count, fn_v, fn_w)
+    return handle
+
+
 class Wall:
     """A rigid segment. ``velocity`` and ``angular_velocity`` may be changed between runs."""
 
@@ -294,6 +336,19 @@ class Wall:
         r = self._row()
         return np.array([r[stepk.W_CX], r[stepk.W_CY]])
 
+    def _set_center(self, c):
+        self._set([stepk.W_CX, stepk.W_CY], c)
+
+    def motion(self, velocity=None, angular_velocity=None, center=None):
+        """Move this wall by functions of time (machinery): ``velocity`` (2 numbers,
+        m/s) and ``angular_velocity`` (rad/s, counter-clockwise, about :attr:`center`),
+        each a constant or a function of the time t (s) returning them, evaluated at
+        the start of every step (a vibration: ``tdem.motion.vibration``); ``center``
+        the point it turns about now (it moves with the wall). A part left None is
+        held at 0; ``motion()`` stops the wall. The force and moment it receives are
+        :attr:`force` and :attr:`moment`."""
+        return _set_motion(self, "wall", self.index, 1, velocity, angular_velocity, center, 2)
+
     @property
     def endpoints(self):
         r = self._row()
@@ -308,6 +363,7 @@ class Wall:
         (relaxation in (0, 1]); ``max_speed`` caps it (default: 0.01 × the smallest radius
         per step). ``wall.servo()`` switches the control off and stops the wall."""
         sim = self._sim
+        sim._motions.pop(("wall", self.index), None)
         row = self._row()
         if force is None and stress is None:
             self._set([stepk.W_SERVO_K, stepk.W_VX, stepk.W_VY], [0.0, 0.0, 0.0])
@@ -378,6 +434,21 @@ class Mesh:
     def center(self):
         return self._rows()[0, stepk.T_OX:stepk.T_OX + 3].copy()
 
+    def _set_center(self, c):
+        self._set(stepk.T_OX, c)
+
+    def motion(self, velocity=None, angular_velocity=None, center=None):
+        """Move this mesh by functions of time (machinery: a drum, a mixer's blade, a
+        vibrating plate): ``velocity`` (3 numbers, m/s) and ``angular_velocity``
+        (rad/s, a 3-vector: a rotation about any axis through :attr:`center`), each a
+        constant or a function of the time t (s) returning them, evaluated at the start
+        of every step (``tdem.motion.vibration`` makes a vibration's); ``center`` the
+        point it turns about now (it moves with the mesh). A part left None is held at
+        0; ``motion()`` stops the mesh. The force and torque it receives are
+        :attr:`force` and :attr:`torque`."""
+        first, count = self._sim._meshes[self.index]
+        return _set_motion(self, "mesh", first, count, velocity, angular_velocity, center, 3)
+
     @property
     def triangles(self):
         """The triangles' corners now, (T, 3, 3)."""
@@ -400,6 +471,7 @@ class Mesh:
         per step). The mesh translates; ``mesh.servo()`` switches the control off and
         stops it."""
         sim = self._sim
+        sim._motions.pop(("mesh", self.index), None)
         first, count = sim._meshes[self.index]
         if force is None and stress is None:
             sim._mesh_servo.pop(self.index, None)

@@ -553,6 +553,20 @@ class Runner:
             self._load_fn = any_fn
         self._a["fext"].from_numpy(ext.astype(np.float64 if self._fdt == ti.f64 else np.float32))
 
+    def _apply_motions(self, t):
+        """Walls and meshes moved by functions of time: their velocities for the step
+        from ``t`` (stage 1 of :meth:`_one_step`), set on the device by
+        :func:`tdem.step.set_motion`; nothing is read back."""
+        for (kind, index), (first, count, vel, ang) in self._motions.items():
+            v = _motion_value(f"{kind} {index}: velocity", vel, t, self.dim)
+            w = _motion_value(f"{kind} {index}: angular_velocity", ang, t,
+                              1 if self.dim == 2 else 3)
+            vv = (0.0, 0.0, 0.0) if v is None else tuple(v) + (0.0,) * (3 - len(v))
+            ww = (0.0, 0.0, 0.0) if w is None else ((0.0, 0.0, w[0]) if len(w) == 1
+                                                   else tuple(w))
+            stepk.set_motion(self._a["wall"], first, count, int(v is not None),
+                             int(w is not None), *vv, *ww, self.dim)
+
     def _load_value(self, fn, t, ids, col):
         """A load given as a function of time, at ``t``: one number per id, or (3D
         moments, ``col`` a slice) one 3-vector per id; refused naming the load."""
@@ -669,6 +683,8 @@ class Runner:
             self._apply_fixes(t=self._time)
         if self._load_fn:
             self._apply_loads(t=self._time)
+        if self._motions:
+            self._apply_motions(self._time)
         if cont is not None:
             cont.prescribed(self)
         # on a GPU the rebuild kernel runs every step and returns at once unless the
@@ -1167,3 +1183,20 @@ class _LongRun:
             bar.write(text, file=sys.stderr)
         else:
             print(text, file=sys.stderr, flush=True)
+
+
+def _motion_value(name, fn, t, n):
+    """A motion's function of time (None: not prescribed) at ``t``: ``n`` finite
+    numbers, or an error naming it."""
+    if fn is None:
+        return None
+    raw = fn(t)
+    try:
+        v = np.asarray(raw, dtype=float).reshape(n)
+    except (TypeError, ValueError):
+        v = None
+    if v is None or not np.isfinite(v).all():
+        raise InputError(f"{name} as a function of time returned {raw!r} at "
+                         f"t = {float(t):.6g} s; it must return {n} finite number"
+                         + ("s" if n > 1 else ""))
+    return v

@@ -206,6 +206,7 @@ class Simulation(Runner, Results):
         self._walls_host = []      # rows of the wall table
         self._periodic = [None] * self.dim   # (start, end) of the periodic x, y (z) axes
         self._meshes = []          # 3D: (first triangle row, number of rows) of each mesh
+        self._motions = {}         # (kind, index) -> (first, count, velocity, angular velocity)
         self._mesh_servo = {}      # 3D: mesh index -> (k, target, direction, relaxation, vmax)
         self._mservo_arr = None    # ... their rows on the device (tdem.step.servo_meshes)
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities

@@ -1027,6 +1027,33 @@ def servo_meshes(wall: ti.types.ndarray(), wforce: ti.types.ndarray(),
                 wall[w, T_VX + c] = v * d[c]
 
 
+@cached
+@ti.kernel
+def set_motion(wall: ti.types.ndarray(), first: ti.i32, count: ti.i32, set_v: ti.i32,
+               set_w: ti.i32, vx: ti.f64, vy: ti.f64, vz: ti.f64, wx: ti.f64, wy: ti.f64,
+               wz: ti.f64, dim: ti.template()):
+    """The velocity and angular velocity of the wall rows ``first`` .. ``first + count``
+    (a segment in 2D: (vx, vy) and wz; a mesh's triangles in 3D) for the next step,
+    from a motion given as functions of time (``Wall.motion``, ``Mesh.motion``); the
+    step moves the rows by them, as it does constant ones."""
+    for w in range(first, first + count):
+        if ti.static(dim == 2):
+            if set_v:
+                wall[w, W_VX] = vx
+                wall[w, W_VY] = vy
+            if set_w:
+                wall[w, W_OMEGA] = wz
+        else:
+            if set_v:
+                wall[w, T_VX] = vx
+                wall[w, T_VX + 1] = vy
+                wall[w, T_VX + 2] = vz
+            if set_w:
+                wall[w, T_WX] = wx
+                wall[w, T_WX + 1] = wy
+                wall[w, T_WX + 2] = wz
+
+
 @ti.kernel
 def largest_overlap_ratio(cs: ti.types.ndarray(), nbr: ti.types.ndarray(),
                           ncnt: ti.types.ndarray(), wcs: ti.types.ndarray(),
