@@ -546,7 +546,10 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None, runs=(
                     "four columns, read (decided before any run) as the top block of the "
                     f"rightmost column moving less than half a block width, {LITTLE_DX:g} "
                     "m (largest |dx| over the run): the columns stay on their own "
-                    "footprints, as in Fig. 26"),
+                    "footprints, as in Fig. 26. The paper gives no block density; the "
+                    "sweep over it (--sweep --densities, docs/cases.md) shows concrete's "
+                    "2400 kg/m³ sliding 0.22 m at the quick preset and 4000 kg/m³ and up "
+                    "moving 1.4 cm or less"),
                 common.check(
                     f"{name}.little_movement_rotation", rotm, None,
                     common.between(max=LITTLE_ROT), "deg",
