@@ -379,6 +379,75 @@ def bands_formed(times, x0, tip_x, eps, depth, radius, window, threshold=None,
     return {"x0": formed_x, "time": formed_t, "active": active}
 
 
+BAND_HOW = ("bands formed in the soil's initial coordinates, window by window "
+            f"({BAND_WINDOW:g} s paper-equivalent; a band: a peak of the plastic strain "
+            f"gained in the window, of height and prominence >= {BAND_INCREMENT:g}, across "
+            "the middle third of the layer being cut, ahead of the edge; module docstring)")
+
+
+def band_checks(band_x0, band_times, equiv, t_eq, radius):
+    """The three band checks from the bands formed (initial x0, time since the cut
+    started): the paper describes the bands of its first 11 s ("at time 11 s, the third
+    shear band forms"; nothing after), so the count, the times and the spacing are of
+    the bands formed by then (+ the 1 s its 'about' allows); all are in ``data``."""
+    until = PAPER["band_times_s"][-1] + 1.0
+    paper_bands = [t for t in PAPER["band_times_s"] if common.reached(t_eq, t)]
+    early = [(x, t * equiv) for x, t in zip(band_x0, band_times) if t * equiv <= until]
+    times_eq = [t for _, t in early]
+    xs = np.sort([x for x, _ in early])
+    spacing = float(np.mean(np.diff(xs))) if len(xs) >= 2 else float("nan")
+    two_bands = len(paper_bands) >= 2
+    window = min(until, t_eq)
+    return [
+        common.check(
+            "bands_count", len(early), len(paper_bands), common.absolute(0), "",
+            f"{BAND_HOW}: formed by {window:g} s paper-equivalent (the paper describes its "
+            f"first 11 s) at x0 = {', '.join(f'{x:.2f}' for x in xs) or 'none'} m; paper: "
+            f"bands at about 2, 6 and 11 s, {len(paper_bands)} of them by then"),
+        common.check(
+            "band_spacing", spacing, PAPER["band_spacing_m"],
+            common.absolute(2 * radius) if two_bands else None, "m",
+            "mean distance between neighbouring bands formed by then, in the soil's "
+            "initial coordinates; within one particle diameter (the detection's bin)"
+            + ("" if two_bands else "; the paper's second band is beyond this run: "
+                                    "reported, not compared")),
+        common.check(
+            "band_formation_times", times_eq[:len(paper_bands)] if paper_bands else times_eq,
+            paper_bands or None, common.absolute(1.0) if paper_bands else None, "s",
+            "paper-equivalent time (blade travel / 0.1 m/s) at which each band formed (the "
+            "end of the first window it is active in); the paper's 'about' read as within "
+            "1 s"),
+    ]
+
+
+def rescore(out):
+    """Recompute the band checks of a finished run in ``out`` from its
+    ``plastic_strain.npz`` (the measure changed, not the run) and rewrite its
+    ``summary.json``; returns the summary."""
+    import json
+    from pathlib import Path
+    out = Path(out)
+    s = json.loads((out / "summary.json").read_text())
+    d = np.load(out / "plastic_strain.npz")
+    model = s["data"]["model"]
+    R = model["radius_m"]
+    equiv = model["blade_speed_m_s"] / PAPER_SPEED
+    f = bands_formed(d["time"], d["x0"], d["tip_x"], d["plastic_strain"],
+                     model["blade_geometry"]["cut_depth_m"], R, BAND_WINDOW / equiv)
+    new = {c["name"]: c for c in band_checks(f["x0"], f["time"], equiv,
+                                             model["paper_equivalent_end_s"], R)}
+    checks = [new.get(c["name"], c) for c in s["checks"]]
+    s["data"]["bands_formed"].update({"x0_m": f["x0"], "time_s": f["time"],
+                                      "time_paper_equivalent_s": [t * equiv for t in f["time"]],
+                                      "active_per_window": f["active"].tolist()})
+    s["data"]["band_detection"] = BAND_HOW
+    fresh = common.summary(s["case"], s["preset"], checks, s["data"], s["wall_time_s"],
+                           threads=s.get("threads"), paper=s.get("paper"), notes=s.get("notes"))
+    fresh["date"] = s["date"]
+    common.write_summary(out, fresh)
+    return fresh
+
+
 # ------------------------------------------------------------------- plots
 def _draw_state(ax, snap, radius, blade_tri, ytop):
     from matplotlib.collections import EllipseCollection
@@ -588,9 +657,6 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
     formed = bands_formed(strain_t, m["x0"], tip0 + speed * np.asarray(strain_t),
                           np.asarray(strain_eps), depth, R, BAND_WINDOW / equiv)
     band_x0, band_times = formed["x0"], formed["time"]
-    order = np.argsort(band_x0)
-    spacing = (float(np.mean(np.diff(np.asarray(band_x0)[order]))) if len(band_x0) >= 2
-               else float("nan"))
     sensitivity = {}
     for thr in BAND_SENSITIVITY["threshold"]:
         for win in BAND_SENSITIVITY["window"]:
@@ -634,8 +700,6 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
 
     travel = speed * T
     speeds = np.linalg.norm(sim.particles.numpy()["velocity"], axis=1)
-    note_eq = (f"paper-equivalent time = blade travel / 0.1 m/s = {equiv:g} x the time of "
-               f"this run (blade {speed} m/s), which ends at {t_eq:g} s paper-equivalent")
 
     def when(paper_time):
         """A figure the paper gives at ``paper_time`` (paper-equivalent): compared if the
@@ -644,34 +708,11 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
         return ok, ("" if ok else f"; the paper's is at {paper_time:g} s, beyond this run's "
                                   f"{t_eq:g} s: reported, not compared")
 
-    paper_bands = [t for t in PAPER["band_times_s"] if common.reached(t_eq, t)]
     times_eq = [t * equiv for t in band_times]
     rise_ok, rise_note = when(PAPER["P1_rise_s"])
     peak_ok, peak_note = when(PAPER["P1_peak_time_s"])
     end_ok, end_note = when(27.5)
-    two_bands = len(paper_bands) >= 2
-    how = (f"bands formed in the soil's initial coordinates, window by window "
-           f"({BAND_WINDOW:g} s paper-equivalent; a band: a peak of the plastic strain "
-           f"gained in the window, of height and prominence >= {BAND_INCREMENT:g}, across "
-           "the middle third of the layer being cut, ahead of the edge; module docstring)")
-    checks = [
-        common.check(
-            "bands_count", len(band_x0), len(paper_bands), common.absolute(0), "",
-            f"{how}: formed at x0 = {', '.join(f'{x:.2f}' for x in band_x0) or 'none'} m; "
-            f"paper: bands at about 2, 6 and 11 s paper-equivalent, {len(paper_bands)} of "
-            "them by the end of this run"),
-        common.check(
-            "band_spacing", spacing, PAPER["band_spacing_m"],
-            common.absolute(2 * R) if two_bands else None, "m",
-            "mean distance between neighbouring bands in the soil's initial coordinates; "
-            "within one particle diameter (the detection's bin)"
-            + ("" if two_bands else "; the paper's second band is beyond this run: "
-                                    "reported, not compared")),
-        common.check(
-            "band_formation_times", times_eq[:len(paper_bands)] if paper_bands else times_eq,
-            paper_bands or None, common.absolute(1.0) if paper_bands else None, "s",
-            "paper-equivalent time at which each band formed (the end of the first window "
-            "it is active in); the paper's 'about' read as within 1 s; " + note_eq),
+    checks = band_checks(band_x0, band_times, equiv, t_eq, R) + [
         common.check(
             "free_face_stands", float(max(face_u)) if face_u else None, None,
             common.between(max=FACE_BOUND), "m",
@@ -737,7 +778,7 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
         "blade_Fx_max_abs_N_per_m": float(np.max(np.abs(vF))),
         "speed_end_m_s": {"max": float(speeds.max()), "median": float(np.median(speeds)),
                           "above_2x_blade": int(np.sum(speeds > 2.0 * speed))},
-        "band_detection": how,
+        "band_detection": BAND_HOW,
         "band_history": {"time_s": band_t, "count": band_n},
         "runtime_s": {"settle": settle_s, "cut": cut_s},
     }
@@ -771,10 +812,17 @@ def _extra(p):
                         f"{BLADE_TOP:g})")
     p.add_argument("--duration", type=float, default=None, metavar="S",
                    help="seconds of cutting (default: the preset's)")
+    p.add_argument("--rescore", default=None, metavar="DIR",
+                   help="recompute the band checks of the finished run in DIR from its "
+                        "plastic_strain.npz and rewrite its summary.json (no run)")
 
 
 def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
+    if args.rescore:
+        s = rescore(args.rescore)
+        common.print_checks(s)
+        return 0
     s = run(args.preset, out, arch=args.arch, threads=args.threads,
             duration=args.duration, elastic_blade=True if args.elastic_blade else None,
             blade={"angle": args.blade_angle, "depth": args.cut_depth, "top": args.blade_top})

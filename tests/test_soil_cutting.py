@@ -126,3 +126,20 @@ def test_free_face_stands_undamped_with_the_blade_at_rest():
     assert len(face) >= 10
     assert np.linalg.norm(p["position"][face] - ref[face], axis=1).max() < 1e-4
     assert p["plastic_strain"][face].max() < 1e-3
+
+
+def test_band_checks_take_the_bands_the_paper_describes():
+    """The paper describes the bands of its first 11 s: bands formed at 2, 2.75, 5,
+    6.75, 10.75 and 14 s paper-equivalent (blade at the paper's speed) count 5 (the
+    one at 14 s is after 11 s + 1 s), their spacing the mean gap of their x0, their
+    times the first three against 2, 6 and 11 s."""
+    x0 = [0.25, 0.39, 0.65, 0.93, 1.19, 1.29]
+    times = [2.0, 2.75, 5.0, 6.75, 10.75, 14.0]
+    c = {k["name"]: k for k in sc.band_checks(x0, times, 1.0, 27.5, 0.01)}
+    assert c["bands_count"]["value"] == 5 and c["bands_count"]["target"] == 3
+    assert c["band_spacing"]["value"] == pytest.approx((1.19 - 0.25) / 4)
+    assert c["band_formation_times"]["value"] == [2.0, 2.75, 5.0]
+    # a quick run (5 x the speed, 6 s paper-equivalent): the paper's first two bands
+    c = {k["name"]: k for k in sc.band_checks([0.3], [0.5], 5.0, 6.0, 0.025)}
+    assert c["bands_count"]["value"] == 1 and c["bands_count"]["target"] == 2
+    assert c["band_formation_times"]["value"] == [2.5]
