@@ -38,7 +38,7 @@ from physics.polyhedron import Polyhedron
 from .continuum import SAVED as CONTINUUM_SAVED
 from . import mesh as _mesh
 from .errors import InputError
-from .step import T_LAW, W_LAW, wall_width
+from .step import T_LAW, TRI_WIDTH, W_LAW, wall_width
 
 FORMAT = "tdem-checkpoint"
 VERSION = 4     # 2: particle shapes and angles; two more history columns; 3: work account;
@@ -278,6 +278,12 @@ def _read(path):
         state = {k: r.array(k, st) for k in r.keys(st)}
         hg = r.node("host")
         host = {k: r.array(k, hg) for k in r.keys(hg)}
+        if cfg.get("dim", 2) == 3:
+            # mesh rows written before the belts' surface velocity (21 columns)
+            for table, k in ((host, "walls"), (state, "wall")):
+                t = table.get(k)
+                if t is not None and t.ndim == 2 and t.shape[1] == TRI_WIDTH - 3:
+                    table[k] = np.concatenate([t, np.zeros((len(t), 3))], axis=1)
         blocks = []
         bg = r.node("blocks") if r.has("blocks") else None
         for key in r.keys(bg) if bg is not None else []:

@@ -437,6 +437,17 @@ class Mesh:
     def _set_center(self, c):
         self._set(stepk.T_OX, c)
 
+    @property
+    def surface_velocity(self):
+        """A conveyor belt: the velocity (m/s, a 3-vector) of the mesh's surface along
+        itself, its part in each triangle's plane added to the velocity particles
+        meet there (the triangles themselves do not move with it)."""
+        return self._rows()[0, stepk.T_SX:stepk.T_SX + 3].copy()
+
+    @surface_velocity.setter
+    def surface_velocity(self, v):
+        self._set(stepk.T_SX, _vector2("surface_velocity", v, 3))
+
     def motion(self, velocity=None, angular_velocity=None, center=None):
         """Move this mesh by functions of time (machinery: a drum, a mixer's blade, a
         vibrating plate): ``velocity`` (3 numbers, m/s) and ``angular_velocity``

@@ -71,10 +71,13 @@ def periodic_axes(simp: ti.template(), dim: ti.template()):
 
 # 3D: the columns of a mesh triangle's row of the wall table (tdem.step): vertices
 # a, b, c, translation velocity, angular velocity, centre of rotation (the mesh's),
-# law, displacement since the lists were built, mesh index
+# law, displacement since the lists were built, mesh index, surface velocity (a
+# conveyor belt: its part in the triangle's plane moves the contact point, not the
+# triangle; checkpoints of 21 columns are read with it zero)
 (T_AX, T_BX, T_CX, T_VX, T_WX, T_OX) = (0, 3, 6, 9, 12, 15)
 T_LAW, T_DISP, T_MESH = 18, 19, 20
-TRI_WIDTH = 21
+T_SX = 21
+TRI_WIDTH = 24
 
 
 @ti.func

@@ -30,7 +30,7 @@ from physics.geometry.ellipsoid import rotation
 from physics.geometry.frame import moment, tangent_part
 from physics.polyhedron import PI_TRIS, PT_LENGTH, PT_NE, PT_NF, PT_NT, PT_PLANES, PT_VERTS
 
-from .neighbors import (F_NONCONV, T_AX, T_BX, T_CX, T_LAW, T_OX, T_VX, T_WX, image,
+from .neighbors import (F_NONCONV, T_AX, T_BX, T_CX, T_LAW, T_OX, T_SX, T_VX, T_WX, image,
                         tri_vec)
 from .state import PROP_MASS, PROP_RADIUS
 
@@ -276,7 +276,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             n = -nf
             arm = cen - xi
             o = tri_vec(wall, w, T_OX)
-            vw = tri_vec(wall, w, T_VX) + tri_vec(wall, w, T_WX).cross(cen - o)
+            vw = tri_vec(wall, w, T_VX) + tri_vec(wall, w, T_WX).cross(cen - o) \
+                + tangent_part(tri_vec(wall, w, T_SX), n)       # a belt's surface
             vrel = vw - vel[i] - omega[i].cross(arm)
             vn = vrel.dot(n)
             u = vol / l2

@@ -31,7 +31,7 @@ from .launch import cached
 from .neighbors import (F_BAD, F_FAST, F_PUSH, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL, P_CHUNK,  # noqa: F401
                         P_DT, P_GX, P_GY, P_GZ, P_NWALLS, P_PLX, P_PLY, P_PLZ, P_PX0, P_PY0,
                         P_PZ0, P_SKIN, SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH,
-                        T_OX, T_VX, T_WX, TRI_WIDTH, gravity, image, periodic_axes, slot_bits,
+                        T_OX, T_SX, T_VX, T_WX, TRI_WIDTH, gravity, image, periodic_axes, slot_bits,
                         tri_vec)
 from . import polyhedra3d, shaped3d
 from .shaped import shape_of, shaped_pair, shaped_wall
@@ -422,7 +422,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                                 whist[i, s2] = zero_history(h2)
             arm = point - xi
             c = tri_vec(wall, w, T_OX)
-            vw = tri_vec(wall, w, T_VX) + spin_cross(tri_vec(wall, w, T_WX), point - c)
+            vw = tri_vec(wall, w, T_VX) + spin_cross(tri_vec(wall, w, T_WX), point - c) \
+                + tangent_part(tri_vec(wall, w, T_SX), n)       # a belt's surface
             vrel = vw - vel[i] - spin_cross(omega[i], arm)
             vn = vrel.dot(n)
             L = ti.cast(wall[w, T_LAW], ti.i32)
