@@ -111,10 +111,11 @@ must stand (Rankine's critical height of a vertical cut, 4c/(γ sqrt(K_a)) = 3.3
 through the undamped run, from the base to ``FACE_BELOW`` (0.2 m) below the
 cutting edge (the edge scrapes the few particles just below it off the face; they
 are held where they fall below the base, ``data.fallen``). With the blade at rest the
-face stands (it moves by 1e-5 m in 1 s undamped: tests/test_soil_cutting.py); as
-the blade cuts, its edge presses on the soil below it and loads the face's crest
-(the quick preset: the face 0.5 m up moves out by 2 cm while the edge passes over
-it, and by 7 cm by the end, slowing). P4's bulk stress is also read 0.05, 0.2 and 0.3 m from
+face stands (under 1e-5 m over 20 s undamped; 1 s in tests/test_soil_cutting.py); in
+the run it moves (the quick preset: the face 0.5 m up out by 2 cm while the edge
+passes over it, 7 cm by the end; the paper preset: 2-5 cm, then a slump from 17 s):
+what sets it off, the edge passing over its crest or the soil the blade drops behind
+it, is not yet measured. P4's bulk stress is also read 0.05, 0.2 and 0.3 m from
 both fixed sides (``data.P4_bulk_stress_end_Pa_by_distance_m``): the paper does
 not give P4's position, and near the fixed corner the stress changes fast with it.
 
@@ -721,9 +722,10 @@ def run(preset="quick", out=None, arch=None, threads=None, duration=None,
             "the particles just below it off the face): it stands if it moves less than 1 cm, 20 x its settlement under "
             "gravity; Rankine's critical height of a vertical cut in this soil is "
             f"{rankine_height():.1f} m ({rankine_height(tension=False):.1f} m without "
-            "tension), above the face's 0.72 m; with the blade at rest it stands (1e-5 m "
-            "in 1 s undamped: tests/test_soil_cutting.py): what moves it is the blade's "
-            "edge pressing on the soil below it as it passes over the face's crest"),
+            "tension), above the face's 0.72 m; with the blade at rest it stands (under "
+            "1e-5 m in 1 s undamped: tests/test_soil_cutting.py; 20 s measured): what "
+            "moves it in the run, the edge passing over its crest or the soil the blade "
+            "drops behind it, is not yet measured"),
         common.check(
             "P1_rise_time", float(tP1[rise[0]]) * equiv if len(rise) else None,
             PAPER["P1_rise_s"], common.absolute(1.0) if rise_ok else None, "s",
