@@ -257,11 +257,9 @@ def _motion_part(name, v, n):
     called, every step), or a constant of ``n`` finite numbers (returned as an array)."""
     if v is None or callable(v):
         return v
-    try:
-        a = np.asarray(v, dtype=float).reshape(n)
-    except (TypeError, ValueError):
-        a = None
-    if a is None or not np.isfinite(a).all():
+    from .motion import as_vector
+    a = as_vector(v, n)
+    if a is None:
         raise InputError(f"{name} must be None, {n} finite number"
                          + ("s" if n > 1 else "") + f" or a function of time, got {v!r}")
     return a

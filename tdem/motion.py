@@ -12,6 +12,17 @@ from .errors import InputError
 __all__ = ["vibration"]
 
 
+def as_vector(value, n):
+    """``value`` as ``n`` finite numbers (an array), or None if it is not: the one
+    check of a motion's parts, constants (``Wall.motion``) and the values its
+    functions of time return (each step, :meth:`tdem.runner.Runner._apply_motions`)."""
+    try:
+        a = np.asarray(value, dtype=float).reshape(n)
+    except (TypeError, ValueError):
+        return None
+    return a if np.isfinite(a).all() else None
+
+
 def vibration(amplitude, frequency, direction, phase=0.0):
     """The velocity of a harmonic vibration, as a function of time: the displacement
     ``amplitude`` × sin(2π ``frequency`` t + ``phase``) along the unit of ``direction``

@@ -1190,12 +1190,10 @@ def _motion_value(name, fn, t, n):
     numbers, or an error naming it."""
     if fn is None:
         return None
+    from .motion import as_vector
     raw = fn(t)
-    try:
-        v = np.asarray(raw, dtype=float).reshape(n)
-    except (TypeError, ValueError):
-        v = None
-    if v is None or not np.isfinite(v).all():
+    v = as_vector(raw, n)
+    if v is None:
         raise InputError(f"{name} as a function of time returned {raw!r} at "
                          f"t = {float(t):.6g} s; it must return {n} finite number"
                          + ("s" if n > 1 else ""))
