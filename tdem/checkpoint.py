@@ -45,15 +45,19 @@ VERSION = 4     # 2: particle shapes and angles; two more history columns; 3: wo
                 # 4: each block's boundary edges listed once for its point-edge couples
 _FIX_NAMES = ("vx", "vy", "omega")
 _FIX_NAMES_3D = ("vx", "vy", "vz", "omega")
-_HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle", "omega")
+_HOST_KEYS = ("pos", "vel", "radius", "density", "law", "mat", "shape", "angle", "omega",
+              "ident")
 
 
 def _config(sim):
     laws = sim._laws
     groups = []
+    first = 0
     for g in sim._groups:
+        # (each group is one run of rows: particles removed leave the rest in order)
         law = next(k for k, known in enumerate(laws) if known is g.contact)
-        groups.append({"first": int(g.ids[0]), "count": int(len(g.ids)), "law": law})
+        groups.append({"first": first, "count": int(len(g.ids)), "law": law})
+        first += len(g.ids)
     return {
         "gravity": [float(x) for x in sim.gravity],
         "dt": sim._dt_user,
@@ -86,10 +90,66 @@ def _config(sim):
                        for m, (k, f, d, a, v) in sorted(sim._mesh_servo.items())],
         "polyhedra": [p.input_vertices.tolist() for p in getattr(sim, "_polys", [])],
         "account0": sim._account0,
+        "next_ident": int(sim._next_ident),
+        "flow_offsets": {k: float(v) for k, v in sim._flow_offsets.items()},
+        "inserters": [_inserter_config(sim, ins) for ins in sim._inserters],
+        "outlets": [{"region": o.region.to_dict(), "every": o.every, "name": o.name,
+                     "last": int(o._last)} for o in sim._outlets],
         "couples": [{"ids": None if ids is None else [int(i) for i in ids],
                      "a": None if a is None else int(a.index), "block": int(b.index),
                      "law": law.to_dict()} for ids, a, b, law in sim._couples],
     }
+
+
+def _inserter_config(sim, ins):
+    if ins.shape is not None:
+        raise InputError(f"save: an inserter of shaped particles ({ins.shape!r}) cannot be "
+                         f"saved; stop it (ins.stop()) or save before it is made")
+    d = ins.to_dict()
+    d["law"] = next(k for k, known in enumerate(sim._laws) if known is ins.contact)
+    d["group"] = None if ins.group is None else sim._groups.index(ins.group)
+    return d
+
+
+def _flows_to(f, sim):
+    g = f.create_group("flows")
+    for k, ins in enumerate(sim._inserters):
+        h = g.create_group(f"inserter{k:04d}")
+        h.create_dataset("ids", data=np.asarray(ins.ids, np.int64))
+        h.create_dataset("times", data=np.asarray(ins.times, float))
+    for k, out in enumerate(sim._outlets):
+        h = g.create_group(f"outlet{k:04d}")
+        h.create_dataset("ids", data=np.asarray(out.ids, np.int64))
+        h.create_dataset("times", data=np.asarray(out.times, float))
+        h.create_dataset("masses", data=np.asarray(out.masses, float))
+
+
+def _flows_from(sim, cfg, flows):
+    """The inserters and outlets of a checkpoint, where they were."""
+    from .flows import Inserter, Outlet, Region
+    from .gradings import Grading
+    for k, d in enumerate(cfg.get("inserters", [])):
+        region = Region(sim.dim, **d["region"])
+        ins = Inserter(sim, region, rate=d["rate"], count=d["count"], per_s=d["per_s"],
+                       radius=d["radius"],
+                       grading=None if d["grading"] is None else Grading.from_dict(d["grading"]),
+                       density=d["density"], contact=sim._laws[d["law"]],
+                       velocity=d["velocity"], orientation=d["orientation"],
+                       until=d["until"], seed=d["seed"])
+        ins.t0, ins.mass, ins.count = d["t0"], d["mass"], d["inserted"]
+        ins._pending, ins._stopped = d["pending"], d["stopped"]
+        ins._rng.bit_generator.state = d["rng"]
+        ins.group = None if d["group"] is None else sim._groups[d["group"]]
+        ins.ids, ins.times = flows.get(f"inserter{k:04d}", (ins.ids, ins.times))[:2]
+        sim._inserters.append(ins)
+    for k, d in enumerate(cfg.get("outlets", [])):
+        out = Outlet(sim, Region(sim.dim, **d["region"]), every=d["every"], name=d["name"])
+        out._last = d["last"]
+        got = flows.get(f"outlet{k:04d}")
+        if got is not None:
+            out.ids, out.times, out.masses = got
+            out.count, out.mass = len(out.ids), float(np.sum(out.masses))
+        sim._outlets.append(out)
 
 
 def save(sim, path):
@@ -144,6 +204,7 @@ def save(sim, path):
                                   "particles free", stacklevel=3)
                     continue
                 g.create_dataset(name, data=np.asarray(v, dtype=np.float64))
+        _flows_to(f, sim)
         blocks = f.create_group("blocks")
         for n, b in enumerate(sim._blocks):
             g = blocks.create_group(f"{n:04d}")
@@ -312,12 +373,19 @@ def _read(path):
             names = _FIX_NAMES_3D if cfg.get("dim", 2) == 3 else _FIX_NAMES
             fixes.append((r.array("ids", g), *[r.array(nm, g) if r.has(nm, g) else None
                                                for nm in names]))
+        flows = {}
+        if r.has("flows"):
+            fl = r.node("flows")
+            for key in r.keys(fl):
+                g = r.node(key, fl)
+                flows[key] = tuple(r.array(nm, g) for nm in ("ids", "times", "masses")
+                                   if r.has(nm, g))
     if version < 2:
         _upgrade_v1(state, host)
     if version < 3:
         _upgrade_v2(state)
     raw = dict(cfg=cfg, state=state, host=host, blocks=blocks, cstate=cstate, nonref=nonref,
-               fixes=fixes, version=version)
+               fixes=fixes, version=version, flows=flows)
     _check(r, raw)
     return raw
 
@@ -558,6 +626,8 @@ def load(path, arch=None):
         host["mat"] = np.full(len(host["radius"]), -1)
     if "omega" not in host and "radius" in host:
         host["omega"] = np.zeros(len(host["radius"]))     # written before initial spins
+    if "ident" not in host and "radius" in host:
+        host["ident"] = np.arange(len(host["radius"]))    # written before identities
     for k in _HOST_KEYS:
         sim._host[k] = ([np.array(host[k][a:b]) for a, b in zip(offsets[:-1], offsets[1:])]
                         if k in host else [])
@@ -585,6 +655,9 @@ def load(path, arch=None):
     sim._polys = [Polyhedron(v) for v in cfg.get("polyhedra", [])]
     sim._fixes = fixes
     sim._n = cfg["n"]
+    sim._next_ident = int(cfg.get("next_ident", cfg["n"]))
+    sim._flow_offsets = dict(cfg.get("flow_offsets", {}))
+    _flows_from(sim, cfg, raw.get("flows", {}))
     sim._cap = cfg["cap"]
     sim._capw = cfg["capw"]
     sim._time = cfg["time"]

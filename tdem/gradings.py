@@ -79,6 +79,15 @@ class Grading:
     def r_max(self):
         return 0.5 * self.d_max
 
+    def to_dict(self):
+        """The grading as plain numbers (a checkpoint's): its table and label."""
+        return {"sizes": np.exp(self._u).tolist(), "fraction": self._p.tolist(),
+                "label": self.label}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(d["sizes"], d["fraction"], d.get("label", "grading"))
+
     def passing(self, d):
         """Percent of the mass finer than the diameter(s) ``d`` (m)."""
         u = np.log(np.maximum(np.asarray(d, float), 1e-300))

@@ -147,7 +147,7 @@ def write_particles_vtu(sim, path, particles=None):
     st[:, :2, :2] = p["stress"]
     st[:, 2, 2] = p["stress_zz"]
     point_data = {
-        "id": np.arange(n, dtype=np.int64),
+        "id": np.asarray(p.get("id", np.arange(n)), dtype=np.int64),
         "radius": np.asarray(p["radius"], dtype=np.float64),
         "mass": np.asarray(p["mass"], dtype=np.float64),
         "velocity": _xyz(p["velocity"]),
@@ -195,7 +195,7 @@ def _write_spheres_vtu(path, p, shape):
         axes = 2.0 * np.asarray(shape)[ell, :3]
         tensor[ell] = np.einsum("nij,nj,nkj->nik", rot, axes, rot)
     point_data = {
-        "id": np.arange(n, dtype=np.int64),
+        "id": np.asarray(p.get("id", np.arange(n)), dtype=np.int64),
         "radius": np.asarray(p["radius"], dtype=np.float64),
         "diameter": 2.0 * np.asarray(p["radius"], dtype=np.float64),
         "mass": np.asarray(p["mass"], dtype=np.float64),

@@ -33,7 +33,7 @@ class Results:
             z2 = np.zeros((0, 2))
             z = np.zeros(0)
             out = {"position": z2, "velocity": z2, "omega": z, "angle": z, "radius": z, "mass": z,
-                   "force": z2, "torque": z, "displacement": z2}
+                   "force": z2, "torque": z, "displacement": z2, "id": np.zeros(0, np.int64)}
             if stress:
                 out.update(stress=np.zeros((0, 2, 2)), stress_zz=z, pressure=z,
                            plastic_strain=z, strain=np.zeros((0, 3)))
@@ -47,6 +47,7 @@ class Results:
             "radius": prop[:, 0].copy(), "mass": prop[:, 1].copy(),
             "force": a["force"].to_numpy(), "torque": a["torque"].to_numpy(),
             "displacement": pos - a["pos0"].to_numpy(),
+            "id": np.concatenate(self._host["ident"]),
         }
         if stress:
             sa = self._a.get("stress_out")
@@ -90,7 +91,8 @@ class Results:
             z3 = np.zeros((0, 3))
             z = np.zeros(0)
             return {"position": z3, "velocity": z3, "omega": z3, "orientation": np.zeros((0, 4)),
-                    "radius": z, "mass": z, "force": z3, "torque": z3, "displacement": z3}
+                    "radius": z, "mass": z, "force": z3, "torque": z3, "displacement": z3,
+                    "id": np.zeros(0, np.int64)}
         a = self._a
         prop = a["prop"].to_numpy()
         pos = a["pos"].to_numpy()
@@ -100,6 +102,7 @@ class Results:
             "radius": prop[:, 0].copy(), "mass": prop[:, 1].copy(),
             "force": a["force"].to_numpy(), "torque": a["torque"].to_numpy(),
             "displacement": pos - a["pos0"].to_numpy(),
+            "id": np.concatenate(self._host["ident"]),
         }
 
     def _contacts_numpy(self):
@@ -278,8 +281,11 @@ class Results:
         and the core force between water or explosive particles,
         :meth:`tdem.continuum.Continuum.core_energy`),
         dissipated (damping, friction, rolling), boundary_work (done by walls and
-        prescribed velocities) and total = kinetic + gravitational + elastic + strain +
-        dissipated − boundary_work, which is conserved for DEM models; explosive: the
+        prescribed velocities), inflow and outflow (the energy particles brought in
+        with :meth:`insert` and took out through :meth:`remove_in`: kinetic,
+        gravitational and, going out, their contact springs) and total = kinetic +
+        gravitational + elastic + strain + dissipated − boundary_work + outflow −
+        inflow, which is conserved for DEM models; explosive: the
         internal energy Σ E·V0 of JWL particles (not in total).
 
         integration_error: the energy the time integration made (positive: gained)
@@ -302,8 +308,9 @@ class Results:
         e = self._account_now()
         out = {k: e[k] for k in ("kinetic", "gravitational", "elastic", "strain", "dissipated",
                                  "boundary_work")}
+        out["inflow"], out["outflow"] = e["inflow"], e["outflow"]
         out["total"] = out["kinetic"] + out["gravitational"] + out["elastic"] + out["strain"] \
-            + out["dissipated"] - out["boundary_work"]
+            + out["dissipated"] - out["boundary_work"] + out["outflow"] - out["inflow"]
         out["explosive"] = self._explosive_energy()
         e0 = self._account0 if self._account0 is not None else e
         out["integration_error"] = _integration_error(e, e0)
@@ -401,6 +408,13 @@ class Results:
                 ca = self._cont.a
                 e["P_half"] += 0.5 * dt * float(np.sum(ca["nforce"].to_numpy()
                                                        * ca["nvel"].to_numpy()))
+        # particles inserted and removed (tdem.flows): what the removed ones had booked
+        # stays in the sums; the energy carried in and out is kept apart
+        off = self._flow_offsets
+        for k in e:
+            e[k] += off.get(k, 0.0)
+        for k in ("inflow", "outflow", "elastic_out"):
+            e[k] = off.get(k, 0.0)
         return e
 
     def _explosive_energy(self):
@@ -421,5 +435,5 @@ def _integration_error(e, e0):
         return e[k] - e0[k]
     contact_dissipation = d("dissipated") + d("Wp_damping")
     wall_work = d("boundary_work") - d("Wp_constraints")
-    return (d("W_contacts") + d("W_continuum")) + d("elastic") + d("strain") \
+    return (d("W_contacts") + d("W_continuum")) + d("elastic") + d("elastic_out") + d("strain") \
         + contact_dissipation - wall_work - d("P_half")

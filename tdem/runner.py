@@ -816,6 +816,9 @@ class Runner:
         if (until is None) == (steps is None):
             raise InputError(f"give exactly one of until= or steps=, got until={until!r}, "
                              f"steps={steps!r}")
+        if not self._built and self._inserters:
+            # an inserter may fill an empty model: its first particles come before the build
+            self._flow_events(self._time + self.check_interval * self.dt)
         if not self._built:
             self._build()
         elif self._n and self._built_roll3d != self._rolling3d:
@@ -849,6 +852,9 @@ class Runner:
         watch = _LongRun(self, total, dt) if self.progress is not False and total > 0 else None
         try:
             while self._steps < target:
+                if self._inserters or self._outlets:
+                    self._flow_events(
+                        self._time + min(self.check_interval, target - self._steps) * dt)
                 self._segment(target, bar)
                 if watch is not None and watch(self._steps - done_at_start, bar):
                     watch = None

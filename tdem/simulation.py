@@ -189,7 +189,11 @@ class Simulation(Runner, Results):
         self._pair_override = {}   # (law a, law b) -> law id
         self._groups = []
         self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat", "shape",
-                                      "angle", "omega")}
+                                      "angle", "omega", "ident")}
+        self._next_ident = 0       # the identity of the next particle added (tdem.flows)
+        self._inserters = []       # tdem.flows.Inserter
+        self._outlets = []         # tdem.flows.Outlet
+        self._flow_offsets = {}    # the account's sums of particles removed (tdem.flows)
         self._shaped_cache = None
         self._polys = []          # the distinct polyhedra (their index: the shape tables' row)
         self._nonconv_reported = 0
@@ -442,6 +446,8 @@ class Simulation(Runner, Results):
         self._host["shape"].append(shp)
         self._host["angle"].append(ang)
         self._host["omega"].append(om)
+        self._host["ident"].append(np.arange(self._next_ident, self._next_ident + n))
+        self._next_ident += n
         self._n += n
         g = ParticleGroup(self, ids, contact, rho)
         self._groups.append(g)
@@ -882,6 +888,143 @@ class Simulation(Runner, Results):
     def walls(self):
         return [Wall(self, k) for k in range(len(self._walls_host))] if self.dim == 2 else []
 
+    def insert(self, box=None, sphere=None, polygon=None, rate=None, count=None, per_s=None,
+               radius=None, grading=None, density=2500.0, contact=None, velocity=None,
+               shape=None, orientation="random", until=None, seed=0):
+        """Insert particles during the run (pouring, pluviation, a feed): placed at
+        random, without overlapping any particle, in a region — ``box`` (two corners;
+        an axis of zero width makes it a plane: pluviation), ``sphere`` (centre,
+        radius; a circle in 2D) or ``polygon`` (2D) — at ``rate`` kg/s (2D: kg/s per
+        metre of thickness) or ``per_s`` particles/s from the time of this call, and/or
+        up to ``count`` particles (``count`` alone: all of them, as soon as there is
+        room), until the time ``until`` (s; None: no end). Their size: ``radius``, a
+        ``grading`` (:func:`tdem.grading`: drawn by mass) or a ``shape`` (turned at
+        random unless ``orientation=None``); ``density``, ``contact`` (a law) and
+        ``velocity`` (their initial velocity) as for :meth:`add_particles`; ``seed``
+        makes the draws repeatable.
+
+        Particles are placed between run segments (every ``check_interval`` steps):
+        those due by the end of the coming segment. The region should be clear of
+        walls. A particle that finds no room waits (a warning says so once). Returns an
+        :class:`tdem.flows.Inserter` (``mass``, ``count``, ``ids``, ``times``,
+        ``stop()``). Models with PCMM bodies or blocks take none."""
+        from .flows import Inserter, Region
+        self._refuse_flows("insert")
+        region = Region(self.dim, box=box, sphere=sphere, polygon=polygon)
+        ins = Inserter(self, region, rate=rate, count=count, per_s=per_s, radius=radius,
+                       grading=grading, density=density, contact=contact, velocity=velocity,
+                       shape=shape, orientation=orientation, until=until, seed=seed)
+        if shape is not None:
+            self._check_polyhedral(shape, contact)
+        self._inserters.append(ins)
+        self._crit_cache = None
+        return ins
+
+    def remove_in(self, box=None, sphere=None, polygon=None, every=None, name=None):
+        """An outlet: the particles whose centres lie in the region — ``box`` (two
+        corners), ``sphere`` (centre, radius; a circle in 2D) or ``polygon`` (2D) — are
+        removed, every ``every`` steps (default: every ``check_interval`` steps, when
+        the engine looks at the device), and counted. Returns an
+        :class:`tdem.flows.Outlet`: ``count`` and ``mass`` removed so far, ``ids``,
+        ``times`` and ``masses`` of each, ``rate(window)`` the mass flow. ``name``:
+        a monitor of that name records (count, mass) at each check. Particles with
+        prescribed velocities or applied loads are never removed; the others keep
+        their identities (``particles.numpy()["id"]``). Models with PCMM bodies or
+        blocks take none."""
+        from .flows import Outlet, Region
+        self._refuse_flows("remove_in")
+        region = Region(self.dim, box=box, sphere=sphere, polygon=polygon)
+        out = Outlet(self, region, every=every, name=name)
+        if name is not None:
+            self.monitor(name, lambda sim, o=out: (o.count, o.mass), every=self.check_interval)
+        self._outlets.append(out)
+        return out
+
+    def _refuse_flows(self, what):
+        if self._slots or self._blocks:
+            raise InputError(f"{what}: models with PCMM bodies or blocks cannot gain or "
+                             f"lose particles during a run (their elements join particles "
+                             f"by index)")
+
+    def _particles_near(self, lo, hi):
+        """Positions and radii (bounding) of the particles whose spheres reach into the
+        box [lo, hi] grown by the largest radius."""
+        if not self._n:
+            return np.zeros((0, self.dim)), np.zeros(0)
+        if self._built:
+            x = self._a["pos"].to_numpy()
+            r = self._a["prop"].to_numpy()[:, 0]
+        else:
+            x = np.concatenate(self._host["pos"])
+            r = np.concatenate(self._host["radius"])
+        pad = float(r.max()) * 2.0
+        sel = np.all((x >= np.asarray(lo) - pad) & (x <= np.asarray(hi) + pad), axis=1)
+        return x[sel], r[sel]
+
+    def _held_rows(self):
+        """Rows with prescribed velocities or applied loads (outlets leave them)."""
+        parts = [np.asarray(ids) for ids, *_ in self._fixes + self._loads]
+        return np.unique(np.concatenate(parts)) if parts else np.zeros(0, np.int64)
+
+    def _flow_events(self, t_end):
+        """Between run segments: outlets remove what is inside them, inserters place
+        what is due by ``t_end``."""
+        from .flows import remove_rows
+        if self._built and self._n:
+            found = [(out, out.find()) for out in self._outlets if out.due(self._steps)]
+            rows = np.concatenate([r for _, r in found]) if found else np.zeros(0, np.int64)
+            if len(rows):
+                owner = np.concatenate([np.full(len(r), k) for k, (_, r) in enumerate(found)])
+                rows, first = np.unique(rows, return_index=True)
+                owner = owner[first]
+                if len(rows) >= self._n:
+                    # (the engine's arrays keep one particle)
+                    rows, owner = rows[:-1], owner[:-1]
+                if len(rows):
+                    ids, masses = remove_rows(self, rows)
+                    for k, (out, _) in enumerate(found):
+                        sel = owner == k
+                        if sel.any():
+                            out.record(ids[sel], self._time, masses[sel])
+        for ins in self._inserters:
+            got = ins.batch(t_end)
+            if got is None:
+                continue
+            x, r, turn, mass = got
+            kw = dict(density=ins.density, contact=ins.contact, velocity=ins.velocity)
+            if ins.shape is None:
+                kw["radius"] = r
+            else:
+                kw["shape"] = ins.shape
+                if turn is not None:
+                    kw["orientation" if self.dim == 3 else "angle"] = turn
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)   # (placed without overlap)
+                g = self.add_particles(x, **kw)
+            if not self._merge_last_groups(ins):
+                ins.group = g
+            ins.record(self._host["ident"][-1][-len(r):], self._time, mass)
+            self._flow_offsets["inflow"] = self._flow_offsets.get("inflow", 0.0) + (
+                self._inflow_energy(x, r, ins))
+
+    def _merge_last_groups(self, ins):
+        """An inserter's batches make one group while nothing else is added between."""
+        if ins.group is None or len(self._groups) < 2 or self._groups[-2] is not ins.group:
+            return False
+        new = self._groups.pop()
+        ins.group.ids = np.concatenate([ins.group.ids, new.ids])
+        for k in self._host:
+            last = self._host[k].pop()
+            self._host[k][-1] = np.concatenate([self._host[k][-1], last])
+        return True
+
+    def _inflow_energy(self, x, r, ins):
+        """Kinetic and gravitational energy the inserted particles bring: ½ M v² − M g·x̄
+        (they start without spin and without contacts)."""
+        m = np.array([ins._mass_of(ri) for ri in r])
+        g = np.asarray(self.gravity, float)[:self.dim]
+        return float(0.5 * m.sum() * ins.velocity @ ins.velocity - np.sum(m * (x @ g)))
+
     def fix_particles(self, ids, vx=0.0, vy=None, omega=None, vz=None):
         """Prescribe velocity components of particles ``ids``.
 
@@ -985,7 +1128,8 @@ class Simulation(Runner, Results):
         """Smallest 2·sqrt(m/k) over particles and the laws each one can meet (C&S p. 54),
         and, with continua, the shortest element altitude / c_p (PCMM elements in the
         initial configuration, block triangles)."""
-        key = (self._n, len(self._laws), len(self._walls_host), len(self._pair_override))
+        key = (self._n, len(self._laws), len(self._walls_host), len(self._pair_override),
+               sum(not ins.done for ins in self._inserters))
         if self._crit_cache is None or self._crit_cache[0] != key:
             self._crit_cache = (key, self._critical_dt())
         return self._crit_cache[1]
@@ -1001,8 +1145,10 @@ class Simulation(Runner, Results):
             if len(ids):
                 m = min(m, float(self._a["prop"].to_numpy()[ids, 1].min()))
             crit = min(crit, 2.0 * math.sqrt(m / max(kn, ks)))
+        for r, m, law in self._inserted_probes():
+            crit = min(crit, float(np.min(2.0 * np.sqrt(m / law.critical_stiffness(r, m)))))
         if self._n == 0:
-            if self._blocks:
+            if self._blocks or self._inserters:
                 return crit
             raise InputError("the critical time step needs particles: add some first")
         r, m, plaw = self._masses()
@@ -1032,6 +1178,19 @@ class Simulation(Runner, Results):
         return mass_properties(np.concatenate(self._host["shape"]),
                                np.concatenate(self._host["density"]), self._radii(),
                                self.dim, self._polys)[1]
+
+    def _inserted_probes(self):
+        """(radii, masses, law) of the smallest and largest particle each inserter that
+        is still at work will bring, with every law it may meet (its own, the walls',
+        the other particles'): the time step holds for what is yet to come."""
+        laws = set(range(len(self._laws)))
+        for ins in self._inserters:
+            if ins.done:
+                continue
+            r = np.array(ins.sizes, dtype=float)
+            m = np.array([ins._mass_of(x) for x in r])
+            for u in sorted(laws):
+                yield r, m, self._laws[u]
 
     def _masses(self):
         """(radius, mass, law group) of every particle, from the device once built."""
@@ -1064,11 +1223,17 @@ class Simulation(Runner, Results):
         this one warns (a dense packing would go unstable). Plain DEM particles only
         (PCMM particles are held by their elements, whose bound is in
         :meth:`critical_dt`)."""
+        out = math.inf
+        for r, m, law in self._inserted_probes():
+            kn, ks = law.critical_stiffnesses(r, m)
+            kn = np.broadcast_to(np.asarray(kn, dtype=float), r.shape)
+            ks = np.broadcast_to(np.asarray(ks, dtype=float), r.shape)
+            roll = law.rolling.delta ** 2 / 12.0 if law.rolling is not None else 0.0
+            out = min(out, float(np.min(_stability.stable_dt(kn, ks, m, roll))))
         if self._n == 0:
-            return math.inf
+            return out
         r, m, plaw = self._masses()
         dem = np.concatenate(self._host["mat"]) < 0       # PCMM particles: elements
-        out = math.inf
         for sel, law in self._laws_met(plaw):
             sel = sel & dem
             if not sel.any():

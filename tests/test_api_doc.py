@@ -265,7 +265,8 @@ def _items():
         obj = getattr(tdem, name)
         if name in HANDLES or name == "Simulation" or inspect.ismodule(obj):
             continue
-        cname = r"(?<![\w.])(?:tdem\.)?%s(?!\w)" % re.escape(name)
+        # (a keyword argument of the same name, ``grading=None``, is no mention)
+        cname = r"(?<![\w.])(?:tdem\.)?%s(?![\w=])" % re.escape(name)
         if inspect.isclass(obj):
             items.append(Item(name + "()", obj, [cname]))
             for mname, (kind, m) in sorted(_public_members(obj).items()):
