@@ -12,8 +12,10 @@ with atomic additions, are output only and may differ in the last bits between
 two runs on several threads.
 
 Not saved: monitors and output writers (they hold Python functions; attach them
-again after loading) and prescribed velocities given as functions of time (saved
-as free, with a warning).
+again after loading), prescribed velocities given as functions of time (saved
+as free, with a warning) and motions of walls given as functions other than
+:mod:`tdem.motion`'s (saved as their velocity then, with a warning). Inserters and
+outlets (:mod:`tdem.flows`) are saved with their records and random streams.
 
 Layout of the file:
 
@@ -90,6 +92,7 @@ def _config(sim):
                        for m, (k, f, d, a, v) in sorted(sim._mesh_servo.items())],
         "polyhedra": [p.input_vertices.tolist() for p in getattr(sim, "_polys", [])],
         "account0": sim._account0,
+        "motions": _motions_config(sim),
         "next_ident": int(sim._next_ident),
         "flow_offsets": {k: float(v) for k, v in sim._flow_offsets.items()},
         "inserters": [_inserter_config(sim, ins) for ins in sim._inserters],
@@ -99,6 +102,30 @@ def _config(sim):
                      "a": None if a is None else int(a.index), "block": int(b.index),
                      "law": law.to_dict()} for ids, a, b, law in sim._couples],
     }
+
+
+def _motions_config(sim):
+    """Walls and meshes moved by functions of time: tdem.motion's functions are kept;
+    any other function cannot be, and the wall goes on at its velocity now (a
+    warning says which)."""
+    from .motion import Motion
+    out = []
+    for (kind, index), (first, count, vel, ang) in sorted(sim._motions.items()):
+        parts = []
+        for name, fn in (("velocity", vel), ("angular_velocity", ang)):
+            if fn is None or isinstance(fn, Motion):
+                parts.append(None if fn is None else fn.to_dict())
+                continue
+            warnings.warn(f"save: the {name} of {kind} {index} is a function "
+                          f"({getattr(fn, '__name__', fn)!r}) that cannot be saved; the "
+                          f"loaded simulation keeps its value now (tdem.motion.vibration "
+                          f"and tdem.motion.ramp are kept)", stacklevel=4)
+            parts.append(None)
+        if any(p is not None for p in parts):
+            out.append({"kind": kind, "index": int(index), "first": int(first),
+                        "count": int(count), "velocity": parts[0],
+                        "angular_velocity": parts[1]})
+    return out
 
 
 def _inserter_config(sim, ins):
@@ -658,6 +685,12 @@ def load(path, arch=None):
     sim._next_ident = int(cfg.get("next_ident", cfg["n"]))
     sim._flow_offsets = dict(cfg.get("flow_offsets", {}))
     _flows_from(sim, cfg, raw.get("flows", {}))
+    from .motion import from_dict as _motion
+    for m in cfg.get("motions", []):
+        sim._motions[(m["kind"], m["index"])] = (
+            m["first"], m["count"],
+            None if m["velocity"] is None else _motion(m["velocity"]),
+            None if m["angular_velocity"] is None else _motion(m["angular_velocity"]))
     sim._cap = cfg["cap"]
     sim._capw = cfg["capw"]
     sim._time = cfg["time"]
