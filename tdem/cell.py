@@ -310,8 +310,9 @@ class TriaxialCell:
 
         - ``"sigma3"``: σ_x = σ_y = ``stress`` (constant σ3);
         - ``"p"``: the mean stress (σ_x + σ_y + σ_z)/3 = ``stress`` (constant p): every
-          update sets the lateral target to (3p − σ_z)/2, σ_z the axial stress of the
-          segment just run.
+          update sets the lateral target to (3p − σ_z)/2, σ_z the mean axial stress of
+          the segment just run; the integral term makes up the mean stress's error
+          (the lag of the target behind a changing σ_z included) and keeps σ_x = σ_y.
 
         ``stress`` defaults to :attr:`confining`. Targets are reset every
         ``update_strain`` of axial strain (at least ``record_every`` steps apart) on the
@@ -362,7 +363,7 @@ class TriaxialCell:
         meas_t, meas_e, meas_s = [], [], []
         correction = np.zeros(3)
         seen = 0
-        axial_mean = s0[2]
+        axial = s0[2]
         target = stress
         updates = 0
         length = l0
@@ -370,12 +371,18 @@ class TriaxialCell:
             new = mon.values[seen:]
             if new:
                 v = np.asarray(new)
-                axial_mean = float(v[:, 2].mean())
-                err = target - v[:, :2].mean(axis=0)
-                correction[:2] += integral_gain * err
+                if hold == "sigma3":
+                    correction[:2] += integral_gain * (target - v[:, :2].mean(axis=0))
+                else:
+                    # the mean stress's error, made up by the lateral walls, and their
+                    # own errors against their common target
+                    lateral = v[:, :2].mean(axis=0)
+                    correction[:2] += integral_gain * (
+                        1.5 * (stress - float(v[:, :3].mean()))
+                        + (lateral.mean() - lateral))
+                    axial = float(v[:, 2].mean())
                 seen += len(new)
-            target = stress if hold == "sigma3" else max(0.5 * (3.0 * stress - axial_mean),
-                                                         0.0)
+            target = stress if hold == "sigma3" else max(0.5 * (3.0 * stress - axial), 0.0)
             self._drive_axis(2, strain_rate, length)
             for axis in (0, 1):
                 self._servo_axis(axis, max(target + correction[axis], 0.0), length,
@@ -420,22 +427,27 @@ class TriaxialCell:
 
 
 def hold_error(result, window=0.005):
-    """The largest deviation of the lateral wall stresses σ_x, σ_y from their target
-    (:meth:`TriaxialCell.compress`'s ``target``), each averaged over windows of
-    ``window`` axial strain, as a fraction of the target: the measure of how well the
-    cell holds σ3 (or p)."""
+    """How well a :meth:`TriaxialCell.compress` held its path: the largest deviation,
+    as a fraction of the held stress, of the lateral wall stresses σ_x and σ_y from
+    σ3 (``hold="sigma3"``) or of the mean stress p from its value (``hold="p"``),
+    each averaged over windows of ``window`` axial strain."""
     window = _positive("window", window)
+    if result.get("hold") not in HOLDS:
+        raise InputError(f"result must be a TriaxialCell.compress result, got one with "
+                         f"hold={result.get('hold')!r}")
     ea = np.asarray(result["axial_strain"])
-    s = np.asarray(result["sigma"])[:, :2]
-    tgt = np.asarray(result["target"])
+    target = float(result["hold_stress"])
+    if result["hold"] == "sigma3":
+        s = np.asarray(result["sigma"])[:, :2]
+    else:
+        s = np.asarray(result["p"])[:, None]
     worst = 0.0
     edges = np.arange(0.0, ea.max() + window, window)
     for a, b in zip(edges[:-1], edges[1:]):
         sel = (ea > a) & (ea <= b)
         if sel.sum() < 2:
             continue
-        t = float(tgt[sel].mean())
-        worst = max(worst, float(np.max(np.abs(s[sel].mean(axis=0) / t - 1.0))))
+        worst = max(worst, float(np.max(np.abs(s[sel].mean(axis=0) / target - 1.0))))
     return worst
 
 
