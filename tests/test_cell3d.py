@@ -162,3 +162,21 @@ def test_cell_refuses_bad_input():
         cell.measured_stress(margin=0.05)
     assert sim.steps == 0
     assert math.isfinite(cell.void_ratio())
+
+
+def test_triaxial_3d_case_small(tmp_path):
+    """cases/triaxial_3d.py end to end on a small specimen: its summary follows the
+    schema, σ3 is held within 1 %, the plots are written."""
+    from cases import _common as common
+    from cases import triaxial_3d
+    s = triaxial_3d.main(["--material", "none", "--spheres", "150", "--axial-strain", "0.03",
+                          "--out", str(tmp_path)])
+    assert common.validate(s) == []
+    checks = common.checks_by_name(s)
+    assert checks["hold_none"]["pass"] is True
+    assert checks["hold_none"]["value"] < 0.01
+    assert s["variant"] == "none-spheres-150-axial_strain-0.03"
+    for png in ("triaxial_curves.png", "friction_angles.png"):
+        assert (tmp_path / png).stat().st_size > 10000
+    with pytest.raises(tdem.InputError, match="spheres must be a positive"):
+        triaxial_3d.main(["--spheres", "-5", "--out", str(tmp_path)])
