@@ -218,7 +218,7 @@ def plot_curves(tests, png, hold):
         ax.legend(fontsize=7)
     n = tests[0]["info"]["particles"]
     fig.suptitle(f"Drained triaxial compression, {n} spheres, μ = {FRICTION}, "
-                 f"σ3 = {P0 / 1e3:g} kPa, six servo walls")
+                 f"{'σ3' if hold == 'sigma3' else 'p'} = {P0 / 1e3:g} kPa, six servo walls")
     fig.tight_layout()
     common.save(fig, png)
 

@@ -310,9 +310,12 @@ class TriaxialCell:
 
         - ``"sigma3"``: σ_x = σ_y = ``stress`` (constant σ3);
         - ``"p"``: the mean stress (σ_x + σ_y + σ_z)/3 = ``stress`` (constant p): every
-          update sets the lateral target to (3p − σ_z)/2, σ_z the mean axial stress of
-          the segment just run; the integral term makes up the mean stress's error
-          (the lag of the target behind a changing σ_z included) and keeps σ_x = σ_y.
+          update sets the lateral target to 3p/(η + 2), η = σ_z/σ_lateral the stress
+          ratio of the segment just run (the σ3 at which p is met if the specimen
+          keeps that ratio; (3p − σ_z)/2 instead would feed the change of σ_z that a
+          change of σ3 causes back with a gain of about σ1/(2σ3), over 1 at failure,
+          and oscillate); the integral term makes up the mean stress's error and
+          keeps σ_x = σ_y.
 
         ``stress`` defaults to :attr:`confining`. Targets are reset every
         ``update_strain`` of axial strain (at least ``record_every`` steps apart) on the
@@ -363,7 +366,7 @@ class TriaxialCell:
         meas_t, meas_e, meas_s = [], [], []
         correction = np.zeros(3)
         seen = 0
-        axial = s0[2]
+        ratio = s0[2] / max(0.5 * (s0[0] + s0[1]), 1e-12)
         target = stress
         updates = 0
         length = l0
@@ -380,9 +383,9 @@ class TriaxialCell:
                     correction[:2] += integral_gain * (
                         1.5 * (stress - float(v[:, :3].mean()))
                         + (lateral.mean() - lateral))
-                    axial = float(v[:, 2].mean())
+                    ratio = float(v[:, 2].mean()) / max(float(lateral.mean()), 1e-12)
                 seen += len(new)
-            target = stress if hold == "sigma3" else max(0.5 * (3.0 * stress - axial), 0.0)
+            target = stress if hold == "sigma3" else 3.0 * stress / (ratio + 2.0)
             self._drive_axis(2, strain_rate, length)
             for axis in (0, 1):
                 self._servo_axis(axis, max(target + correction[axis], 0.0), length,
@@ -402,7 +405,8 @@ class TriaxialCell:
         times = np.concatenate([rec_t, np.asarray(t, dtype=float) - t0])
         vals = np.concatenate([np.asarray(rec_v), np.asarray(v, dtype=float).reshape(-1, 6)])
         target_rec = np.concatenate([[stress if hold == "sigma3" else
-                                      max(0.5 * (3.0 * stress - s0[2]), 0.0)], targets])
+                                      3.0 * stress / (s0[2] / max(0.5 * (s0[0] + s0[1]),
+                                                                  1e-12) + 2.0)], targets])
         return self._result(times, vals, l0, target_rec, meas_t, meas_e, meas_s,
                             {"hold": hold, "hold_stress": stress, "strain_rate": strain_rate})
 
