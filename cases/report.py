@@ -40,7 +40,7 @@ from cases import _common as common
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the order of the tables: the papers' order (docs/cases.md)
-ORDER = ("nine_disc", "photoelastic", "biaxial", "elastic_gravity", "uniaxial_compression",
+ORDER = ("nine_disc", "photoelastic", "biaxial", "triaxial_3d", "elastic_gravity", "uniaxial_compression",
          "wave_bar", "bearing_capacity", "soil_cutting", "contact_burst", "water_blocks",
          "plate_loading",
          "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break")
@@ -49,6 +49,7 @@ WHAT = {
     "nine_disc": "nine discs compressed by four walls (Cundall & Strack)",
     "photoelastic": "197 discs in a box: force picture, wall forces (Cundall & Strack)",
     "biaxial": "biaxial tests with rolling resistance (Jiang et al.)",
+    "triaxial_3d": "triaxial compression of spheres between six servo walls (Thornton)",
     "elastic_gravity": "rock under gravity, PCMM against FVM (Feng et al.)",
     "bearing_capacity": "a rigid strip footing pushed into soil: Prandtl's collapse load",
     "uniaxial_compression": "a rock sample compressed to failure (Feng et al.)",

@@ -6,7 +6,8 @@ The public API (see docs/api.md): :class:`Simulation`, the contact laws
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
 :class:`InputError`, :class:`InstabilityError`; :func:`plot_history` plots monitor
-histories; :func:`ensemble` runs a function over many parameter sets on a Dask
+histories; :class:`TriaxialCell` is a cubical cell of six servo-controlled walls
+(3D stress paths); :func:`ensemble` runs a function over many parameter sets on a Dask
 cluster (``tdem.ensemble.grid`` makes a grid of them).
 """
 from coupling.point_edge import PointEdge
@@ -25,6 +26,7 @@ from .errors import CapacityError, InputError, InstabilityError
 from .pack import random_orientations
 from .gradings import Grading, grading
 from .simulation import Block, Mesh, ParticleGroup, Simulation, Wall
+from .cell import TriaxialCell
 from .ensemble import Results as _EnsembleResults, ensemble, grid as _grid
 
 ensemble.grid = _grid                  # tdem.ensemble.grid(a=[...], b=[...])
@@ -37,4 +39,4 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
-           "ensemble", "grading", "Grading", "motion"]
+           "ensemble", "grading", "Grading", "motion", "TriaxialCell"]
