@@ -43,7 +43,8 @@ ROOT = Path(__file__).resolve().parents[1]
 ORDER = ("nine_disc", "photoelastic", "biaxial", "triaxial_3d", "elastic_gravity", "uniaxial_compression",
          "wave_bar", "bearing_capacity", "soil_cutting", "contact_burst", "water_blocks",
          "plate_loading",
-         "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break")
+         "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break",
+         "rotating_drum")
 #: a few words on each case for the overview table
 WHAT = {
     "nine_disc": "nine discs compressed by four walls (Cundall & Strack)",
@@ -62,6 +63,7 @@ WHAT = {
     "impact_benchmarks": "sphere impacts against Hertz and Coulomb theory (Chung & Ooi)",
     "angle_of_repose": "heaps of cubes beside heaps of spheres: angle of repose (Chen)",
     "dam_break": "a water column collapsing: its surge front (Martin & Moyce)",
+    "rotating_drum": "a drum of spheres spun up: its regimes against the Froude number (Mellmann)",
 }
 
 
