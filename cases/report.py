@@ -43,7 +43,8 @@ ROOT = Path(__file__).resolve().parents[1]
 ORDER = ("nine_disc", "photoelastic", "biaxial", "elastic_gravity", "uniaxial_compression",
          "wave_bar", "bearing_capacity", "soil_cutting", "contact_burst", "water_blocks",
          "plate_loading",
-         "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break")
+         "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break",
+         "hopper_discharge")
 #: a few words on each case for the overview table
 WHAT = {
     "nine_disc": "nine discs compressed by four walls (Cundall & Strack)",
@@ -61,6 +62,7 @@ WHAT = {
     "impact_benchmarks": "sphere impacts against Hertz and Coulomb theory (Chung & Ooi)",
     "angle_of_repose": "heaps of cubes beside heaps of spheres: angle of repose (Chen)",
     "dam_break": "a water column collapsing: its surge front (Martin & Moyce)",
+    "hopper_discharge": "a bin emptying through a slot: flow rate against Beverloo's law",
 }
 
 
