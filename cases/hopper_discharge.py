@@ -546,8 +546,7 @@ def finish(args, out, cfg, runs, clock):
         checks.append(common.check(
             f"{tag}.overlap_p99", bed["overlap_p99"], None, common.between(max=OVERLAP_P99),
             "d", f"the 99th percentile of the overlaps over d (the largest: "
-                 f"{bed['overlap_max']:.2e} d, near the floor's corners where the plug "
-                 "meets the floor)"))
+                 f"{bed['overlap_max']:.2e} d)"))
     if fit:
         b = BANDS[dim]
         checks += [
