@@ -29,7 +29,9 @@ Set-up (our choices; the law fixes none of them)
   25 N/m a contact, an overlap of 0.5 % d; the summary reports the mean and largest
   overlap between grains in the settled bed. kn = 2e3 N/m in 3D (the same estimate
   for a contact force ρ_b g H d²: 0.1–0.3 % d). The rate does not change with kn while the overlaps
-  stay small (Beverloo's rate is set by free fall over the arch, not by stiffness).
+  stay small (Beverloo's rate is set by free fall over the arch, not by stiffness):
+  the 2D bin of D = 6 d with kn doubled discharges 1.5 % slower (21.09 against 21.41
+  kg/(s·m)), within the scatter between the two fill windows.
 - Bin: width 24 d (2.5 D_max + 4 d for D_max = 8 d: the rate does not depend on the
   bin once its width is above 2.5 D, Nedderman), fill 40 d high (2D quick preset);
   flat floor, a slot of width D in its middle (3D: a square bin, a floor plate with a
