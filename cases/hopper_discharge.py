@@ -391,8 +391,9 @@ def plot_discharge(runs, cfg, png):
             m0 = np.mean(r["m"][s]) - w["W"] * np.mean(r["t"][s])
             ax.plot(tt, m0 + w["W"] * tt, ls="--" if k == 0 else ":", color="k", lw=1.0)
     ax.axvline(cfg["skip"], color="0.6", lw=0.8)
-    ax.text(cfg["skip"], ax.get_ylim()[1] * 0.97, " start-up left out before this",
-            fontsize=8, va="top", color="0.4")
+    lo, hi = ax.get_ylim()
+    ax.text(cfg["skip"], lo + 0.02 * (hi - lo), " ← start-up left out", fontsize=8,
+            va="bottom", color="0.4")
     ax.plot([], [], "k--", lw=1.0, label="fit, window 1 (higher fill)")
     ax.plot([], [], "k:", lw=1.0, label="fit, window 2 (lower fill)")
     ax.set_xlabel("time since the orifice opened (s)")
