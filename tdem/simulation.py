@@ -194,6 +194,7 @@ class Simulation(Runner, Results):
         self._inserters = []       # tdem.flows.Inserter
         self._outlets = []         # tdem.flows.Outlet
         self._flow_offsets = {}    # the account's sums of particles removed (tdem.flows)
+        self._placed_clear = False  # add_particles of an inserter's batch: no overlap checks
         self._shaped_cache = None
         self._polys = []          # the distinct polyhedra (their index: the shape tables' row)
         self._nonconv_reported = 0
@@ -424,8 +425,11 @@ class Simulation(Runner, Results):
         state = self._download() if self._built else None
         old = state["pos"] if state is not None else (
             np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, self.dim)))
-        _refuse_coincident(old, pos)
-        if material is None:
+        # (an inserter's batch is placed clear of every particle: tdem.flows)
+        clear = self._placed_clear
+        if not clear:
+            _refuse_coincident(old, pos)
+        if material is None and not clear:
             # (a shape's inscribed circle: a warning means a real overlap)
             _warn_overlaps(old, self._dem_radii(state), pos,
                            r if shape is None else np.full(n, shape.inscribed_radius))
@@ -998,9 +1002,11 @@ class Simulation(Runner, Results):
                 kw["shape"] = ins.shape
                 if turn is not None:
                     kw["orientation" if self.dim == 3 else "angle"] = turn
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)   # (placed without overlap)
+            self._placed_clear = True
+            try:
                 g = self.add_particles(x, **kw)
+            finally:
+                self._placed_clear = False
             if not self._merge_last_groups(ins):
                 ins.group = g
             ins.record(self._host["ident"][-1][-len(r):], self._time, mass)
