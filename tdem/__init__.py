@@ -1,7 +1,7 @@
 """tdem: continuum–discontinuum simulation in geomechanics, on Taichi.
 
 The public API (see docs/api.md): :class:`Simulation`, the contact laws
-:class:`LinearContact`, :class:`HertzMindlin`, :class:`VolumeContact` (polyhedra), :class:`RollingResistance` (and
+:class:`LinearContact`, :class:`HertzMindlin`, :class:`VolumeContact` (polyhedra), :class:`RollingResistance`, :class:`ParallelBond` (bonded particles, ``sim.bond``) (and
 :class:`ContactLaw` with :func:`register_law` for laws of one's own), the
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
@@ -16,6 +16,7 @@ from physics.hertz_mindlin import HertzMindlin
 from physics.linear import LinearContact
 from physics.volume_contact import VolumeContact
 from physics.rolling import RollingResistance
+from physics.parallel_bond import ParallelBond
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 from physics.polyhedron import Polyhedron
 from physics.shapes import Ellipsoid, Superellipse
@@ -39,4 +40,4 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
-           "ensemble", "grading", "Grading", "motion", "TriaxialCell"]
+           "ensemble", "grading", "Grading", "motion", "TriaxialCell", "ParallelBond"]

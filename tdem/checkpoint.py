@@ -94,6 +94,7 @@ def _config(sim):
         "account0": sim._account0,
         "motions": _motions_config(sim),
         "next_ident": int(sim._next_ident),
+        "nbonds": int(sim._nbonds),
         "flow_offsets": {k: float(v) for k, v in sim._flow_offsets.items()},
         "inserters": [_inserter_config(sim, ins) for ins in sim._inserters],
         "outlets": [{"region": o.region.to_dict(), "every": o.every, "name": o.name,
@@ -543,6 +544,9 @@ def _check(r, raw):
     if cfg["built"] and n:
         lead = {"particle": (n,), "slot": (n, cap), "wall_slot": (n, capw)}
         for name in schema.saved():
+            if name not in state and schema.BY_NAME[name].owner == "bond" and \
+                    not cfg.get("nbonds", 0):
+                continue                 # written before bonds, or a model without
             if name not in state:
                 r.fail(f"it lacks '/state/{name}'")
             a, v = schema.BY_NAME[name], state[name]
@@ -683,6 +687,10 @@ def load(path, arch=None):
     sim._fixes = fixes
     sim._n = cfg["n"]
     sim._next_ident = int(cfg.get("next_ident", cfg["n"]))
+    sim._nbonds = int(cfg.get("nbonds", 0))
+    if sim._nbonds and not cfg["built"]:
+        sim._bond_host = {k: np.asarray(state[k])[:sim._nbonds]
+                          for k in ("bpair", "bprop", "bstate")}
     sim._flow_offsets = dict(cfg.get("flow_offsets", {}))
     _flows_from(sim, cfg, raw.get("flows", {}))
     from .motion import from_dict as _motion

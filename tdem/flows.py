@@ -507,6 +507,19 @@ def remove_rows(sim, rows):
         state[name] = np.take_along_axis(v, idx, axis=1)
     state["ncnt"] = (state["nbr"] >= 0).sum(axis=1).astype(np.int32)
     state["flags"][F_REBUILD] = 1
+    if sim._nbonds:
+        # bonds: renumbered; the intact ones of a removed particle go (their springs'
+        # energy with the outflow), the broken ones stay as records of their cracks
+        from .bonds import BS_BROKEN
+        nb = sim._nbonds
+        pair = state["bpair"][:nb]
+        mapped = np.where(pair >= 0, new_index[np.maximum(pair, 0)], -1)
+        broken = state["bstate"][:nb, BS_BROKEN] != 0.0
+        keep_b = broken | np.all(mapped >= 0, axis=1)
+        state["bpair"] = mapped[keep_b].astype(np.int32)
+        state["bprop"] = state["bprop"][:nb][keep_b]
+        state["bstate"] = state["bstate"][:nb][keep_b]
+        sim._nbonds = int(keep_b.sum())
     # the host side
     starts = np.cumsum([0] + [len(c) for c in sim._host["radius"]])
     for k in sim._host:

@@ -362,6 +362,14 @@ class Results:
             e["elastic"] = float(stepk.elastic_energy_sum(*schema.bind(
                 stepk.elastic_energy_sum, a, laws=self._law_set, dim=self.dim)))
             e["dissipated"] = float(eacc[:, 0].sum())
+            if self._nbonds:
+                # the bonds: their springs' energy, and what the broken ones released
+                from .bonds import bond_energy
+                out = ti.ndarray(ti.f64, (2,))
+                bond_energy(a["bpair"], a["bprop"], a["bstate"], self._nbonds, out, self.dim)
+                eb = out.to_numpy()
+                e["elastic"] += float(eb[0])
+                e["dissipated"] += float(eb[1])
             e["boundary_work"] = float(eacc[:, 1].sum())
             ws = work.sum(axis=0)
             for c, k in enumerate(("contacts", "continuum", "gravity", "damping",

@@ -32,6 +32,7 @@ from physics.shapes import quaternion_rotations as _rotations
 from physics.volume_contact import VolumeContact
 
 from . import backend, launch, neighbors, sweep
+from . import bonds as _bonds
 from . import state as schema
 from . import step as stepk
 from .continuum import Continuum
@@ -125,6 +126,7 @@ class Runner:
                 "wall_width": stepk.wall_width(self.dim), "laws_set": self._law_set,
                 "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes,
                 "rolling": self._rolling3d, "pshapes": max(len(self._polys), 1),
+                "bonds": max(self._nbonds, 1),
                 "entries": 2 * n if self.broad_phase == "sweep" else 1}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
@@ -150,6 +152,8 @@ class Runner:
         s["flags"] = np.zeros(FLAGS_SIZE, np.int32)
         s["flags"][F_REBUILD] = 1
         s["flags"][F_BAD] = n
+        if self._nbonds:
+            s.update(self._bond_host)
         return s
 
     def _new_rows(self, pos, vel, r, m, inertia, law, shape, angle, omega, cap, capw):
@@ -591,7 +595,8 @@ class Runner:
         # shapes, dim)
         # (the chunk size itself goes up with the engine's parameters, _upload_params)
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
-                           chunk=self._chunk() > 0, loads=bool(self._loads_on), detail=False,
+                           chunk=self._chunk() > 0, loads=bool(self._loads_on),
+                           bonds=self._nbonds > 0, detail=False,
                            continuum=False, laws=self._law_set, shapes=False,
                            dim=self.dim)[:-5]
 
@@ -669,7 +674,8 @@ class Runner:
         4. blocks (physics.blocks) — triangle stresses, ``nforce``;
         5. point–edge contacts (coupling) — ``xforce``, ``nforce``;
         6. viscous (non-reflecting) boundaries — ``xforce``, ``nforce``;
-        7. DEM pairs and walls, gathered with ``xforce``, and the particles' damped
+        7. bonds (tdem.bonds) — their forces, cracks, ``bforce``; DEM pairs and walls,
+           gathered with ``xforce`` and ``bforce``, and the particles' damped
            leapfrog (tdem.step, one kernel) — particle state, contacts, walls; then,
            in 3D models with servo-controlled meshes, their speeds for the next step
            (tdem.step.servo_meshes);
@@ -698,6 +704,11 @@ class Runner:
             cont.block_stresses(self, dt)
             cont.point_edge(self, dt)
             cont.viscous_boundaries(self)
+        if self._nbonds:
+            a = self._a
+            _bonds.bond_forces(a["pos"], a["vel"], a["omega"], a["prop"], a["bpair"],
+                               a["bprop"], a["bstate"], a["bforce"], dt, self._time,
+                               self._nbonds, self.dim)
         if self._n:
             stepk.step(*step_args, int(detail), cont is not None and cont.adds_forces,
                        self._law_set, self._shape_code, self.dim)

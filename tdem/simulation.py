@@ -37,6 +37,7 @@ from . import step as stepk
 from .errors import InputError
 from .handles import (Block, Mesh, ParticleGroup, Wall, _View, _as_xy, _fix_value, _in_box,
                       _vector2)
+from .bonds import BondView
 from .results import Results
 from .neighbors import F_BUILDS, F_NONCONV
 from .runner import MAX_SLOTS, Runner  # noqa: F401  (MAX_SLOTS: part of this module's names)
@@ -233,6 +234,10 @@ class Simulation(Runner, Results):
         self._next_event = 1 << 62
         if dt is not None:
             self._dt_user = self._check_dt_value(dt)
+        self._nbonds = 0           # bonds made (intact and broken: tdem.bonds)
+        self._bond_host = {}       # their rows before the first build
+        self.bonds = BondView(self, broken=False)
+        self.cracks = BondView(self, broken=True)
         self.particles = _View(self._particles_numpy, lambda: self._n)
         self.contacts = _View(self._contacts_numpy, lambda: len(self._contacts_numpy()["pairs"]))
         self.elements = _View(self._elements_numpy,
@@ -944,6 +949,57 @@ class Simulation(Runner, Results):
         self._outlets.append(out)
         return out
 
+    def bond(self, group, law, other=None, gap=0.0):
+        """Bond the particles of ``group`` (indices, a group or a mask) whose surfaces
+        are at most ``gap`` (m) apart — overlapping ones too — with ``law`` (a
+        :class:`tdem.ParallelBond`); with ``other``, only pairs of one particle from
+        each. A bond acts in parallel with the particles' contact law until it breaks
+        (:mod:`physics.parallel_bond`); it then leaves ``sim.bonds`` for
+        ``sim.cracks``. Bonds are carried through neighbour rebuilds, growth,
+        snapshots, replay, insertion, outlets and checkpoints. Returns the number of
+        bonds made. Not across periodic boundaries, nor between PCMM particles."""
+        from physics.parallel_bond import ParallelBond
+        from .bonds import BS_WIDTH, pairs_within
+        if not isinstance(law, ParallelBond):
+            raise InputError(f"law must be a tdem.ParallelBond(...), got {law!r}")
+        g = non_negative("gap", gap)
+        ids_a = indices("group", group, self._n)
+        ids_b = None if other is None else indices("other", other, self._n)
+        if len(ids_a) == 0 or (ids_b is not None and len(ids_b) == 0):
+            raise InputError("group: no particles to bond")
+        if any(p is not None for p in self._periodic):
+            raise InputError("bond: bonds do not cross periodic boundaries; a periodic "
+                             "model takes none")
+        if self._n and (np.concatenate(self._host["mat"])[
+                np.concatenate([ids_a] + ([] if ids_b is None else [ids_b]))] >= 0).any():
+            raise InputError("group: PCMM particles are joined by their elements; bonds "
+                             "are for plain particles")
+        if self._built:
+            state = self._download()
+            pos, rad = state["pos"], state["prop"][:, 0]
+        else:
+            state = None
+            pos, rad = np.concatenate(self._host["pos"]), np.concatenate(self._host["radius"])
+        i, j, d0 = pairs_within(pos, rad, ids_a, ids_b, g)
+        if len(i) == 0:
+            return 0
+        rows = {"bpair": np.stack([i, j], 1).astype(np.int32),
+                "bprop": law.properties(rad[i], rad[j], d0, self.dim),
+                "bstate": np.zeros((len(i), BS_WIDTH))}
+        old = self._nbonds
+        src = state if state is not None else self._bond_host
+        for k, v in rows.items():
+            have = np.asarray(src[k])[:old] if old else v[:0]
+            rows[k] = np.concatenate([have, v])
+        self._nbonds = old + len(i)
+        self._crit_cache = None
+        if state is not None:
+            state.update(rows)
+            self._rebuild_from(state)
+        else:
+            self._bond_host = rows
+        return len(i)
+
     def _refuse_flows(self, what):
         if self._slots or self._blocks:
             raise InputError(f"{what}: models with PCMM bodies or blocks cannot gain or "
@@ -1135,7 +1191,7 @@ class Simulation(Runner, Results):
         and, with continua, the shortest element altitude / c_p (PCMM elements in the
         initial configuration, block triangles)."""
         key = (self._n, len(self._laws), len(self._walls_host), len(self._pair_override),
-               sum(not ins.done for ins in self._inserters))
+               sum(not ins.done for ins in self._inserters), self._nbonds)
         if self._crit_cache is None or self._crit_cache[0] != key:
             self._crit_cache = (key, self._critical_dt())
         return self._crit_cache[1]
@@ -1158,6 +1214,7 @@ class Simulation(Runner, Results):
                 return crit
             raise InputError("the critical time step needs particles: add some first")
         r, m, plaw = self._masses()
+        crit = min(crit, self._bond_critical_dt(r, m))
         shaped = self._shaped_mask()
         inertia = self._inertias() if shaped.any() else None
         for sel, law in self._laws_met(plaw):
@@ -1184,6 +1241,32 @@ class Simulation(Runner, Results):
         return mass_properties(np.concatenate(self._host["shape"]),
                                np.concatenate(self._host["density"]), self._radii(),
                                self.dim, self._polys)[1]
+
+    def _bond_critical_dt(self, r, m):
+        """2·sqrt(m/k) of each bond: its axial and shear springs on the lighter
+        particle, its bending spring (with the shear spring's moment at the radius) on
+        that particle's inertia (the discs' and spheres' 0.5 and 0.4 m R²)."""
+        if not self._nbonds:
+            return np.inf
+        from physics.parallel_bond import BP_KN_A, BP_KN_I, BP_KS_A
+        src = self._a if self._built else None
+        pair = (src["bpair"].to_numpy() if src else self._bond_host["bpair"])[:self._nbonds]
+        prop = (src["bprop"].to_numpy() if src else self._bond_host["bprop"])[:self._nbonds]
+        i, j = pair[:, 0], pair[:, 1]
+        ok = i >= 0
+        i, j, prop = i[ok], j[ok], prop[ok]
+        if not len(i):
+            return np.inf
+        mm = np.minimum(m[i], m[j])
+        rr = np.minimum(r[i], r[j])
+        k = np.maximum(prop[:, BP_KN_A], prop[:, BP_KS_A])
+        share = 0.5 if self.dim == 2 else 0.4
+        krot = prop[:, BP_KN_I] + prop[:, BP_KS_A] * rr ** 2
+        # a particle held by several bonds: the springs add; bounded by the bond count
+        count = np.bincount(np.concatenate([i, j]), minlength=len(m))
+        many = np.maximum(count[i], count[j])
+        return float(min(np.min(2.0 * np.sqrt(mm / (k * many))),
+                         np.min(2.0 * np.sqrt(share * mm * rr ** 2 / (krot * many)))))
 
     def _inserted_probes(self):
         """(radii, masses, law) of the smallest and largest particle each inserter that

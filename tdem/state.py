@@ -15,7 +15,8 @@ saves them); ``setup`` arrays are set by the host between runs (saved, not in th
 snapshot); ``scratch`` arrays are rebuilt whenever needed (neither).
 
 Owners and their shapes: ``particle`` (n,), ``slot`` (n, cap) the half neighbour
-list, ``wall_slot`` (n, capw) a particle's candidate walls, ``wall`` (walls,),
+list, ``wall_slot`` (n, capw) a particle's candidate walls, ``bond`` (bonds,) the
+bonds (:mod:`tdem.bonds`), ``wall`` (walls,),
 ``wall_part`` (chunks, walls) per chunk of the step's pair loop, and fixed-size
 tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's or a wall
 contact's history vector (as wide as the registered contact laws need,
@@ -29,6 +30,7 @@ from dataclasses import dataclass
 import taichi as ti
 
 from physics import contact_law
+from physics.parallel_bond import BP_WIDTH
 from physics.polyhedron import PI_WIDTH, PT_WIDTH
 
 from .core.arrays import ndarray  # noqa: F401  (state.ndarray: the engine's arrays are made by it)
@@ -106,6 +108,14 @@ ENGINE = (
     Array("wcs", "wall_slot", 3, "f", "dynamic", doc="F_n, F_s, overlap (output)"),
     Array("wid_old", "wall_slot", "i", "i32", "scratch", fill=-1, doc="before a rebuild"),
     Array("whist_old", "wall_slot", "HW", "f", "scratch", doc="before a rebuild"),
+    # bonds (tdem.bonds): the pair, its properties, its forces and, once broken, its record
+    Array("bpair", "bond", 2, "i32", "setup", fill=-1, doc="the bond's two particles"),
+    Array("bprop", "bond", BP_WIDTH, "f64", "setup",
+          doc="stiffnesses, cross-section, strengths (physics.parallel_bond.BP_*)"),
+    Array("bstate", "bond", 22, "f64", "dynamic",
+          doc="forces, moments; the crack once broken (tdem.bonds.BS_*)"),
+    Array("bforce", "particle", "DS", "f", "scratch",
+          doc="the bonds' forces and moments on each particle in a step"),
     # walls and tables
     Array("wall", "table", ("walls", "wall_width"), "f64", "dynamic", doc="wall rows (step.W_*)"),
     Array("wforce", "wall", {2: 4, 3: 7}, "f64", "dynamic",
@@ -193,7 +203,8 @@ def shape(a, sizes):
         return tuple(derived[s] if s in derived else sizes[s] if isinstance(s, str) else s
                      for s in a.comps), None
     lead = {"particle": ("n",), "slot": ("n", "cap"), "wall_slot": ("n", "capw"),
-            "wall": ("walls",), "wall_part": ("chunks", "walls")}[a.owner]
+            "wall": ("walls",), "wall_part": ("chunks", "walls"),
+            "bond": ("bonds",)}[a.owner]
     comps = _comps(a, sizes)
     return tuple(sizes[s] for s in lead), (None if comps in (0, "i") else comps)
 

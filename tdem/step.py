@@ -508,8 +508,8 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
          fext: ti.types.ndarray(), lmom: ti.types.ndarray(), ptab: ti.types.ndarray(),
-         pint: ti.types.ndarray(), serial: ti.template(), chunk: ti.template(),
-         loads: ti.template(),
+         pint: ti.types.ndarray(), bforce: ti.types.ndarray(), serial: ti.template(),
+         chunk: ti.template(), loads: ti.template(), bonds: ti.template(),
          detail: ti.i32, continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
     """One step. ``detail`` (1 or 0) also stores what only output reads: per-contact
@@ -530,6 +530,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
 
     ``loads`` (compile-time): applied forces and moments (``fext``, from
     :meth:`tdem.Simulation.apply_force`) act on the particles.
+
+    ``bonds`` (compile-time): the bonds' forces and moments of this step (``bforce``,
+    from :func:`tdem.bonds.bond_forces`) join the contact forces (their work is the
+    contacts').
 
     ``dim`` (compile-time): 2 (discs, superellipses, PCMM, segment walls) or 3 (spheres
     and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D.
@@ -745,6 +749,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     cfk, cmk = unpack(cf[j, k], dim)
                     f -= cfk
                     tq += cmk
+        if ti.static(bonds):
+            fb, mb = unpack(bforce[i], dim)
+            f += fb
+            tq += mb
         fx_cont = vec_zero(dim)
         if ti.static(continuum):
             fx_cont = xforce[i]
