@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import tdem
-from physics.parallel_bond import BP_AREA, BP_INERTIA, BP_KN_A, BP_KN_I, BP_KS_A, BP_KS_J
+from physics.parallel_bond import BP_AREA, BP_INERTIA, BP_KN_I, BP_KS_A, BP_KS_J
 
 E = 1e8
 R = 0.01
