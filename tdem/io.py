@@ -458,6 +458,49 @@ def write_contacts_vtu(sim, path, particles=None):
     return path
 
 
+def write_bonds_vtu(sim, path, particles=None):
+    """Intact bonds (:meth:`tdem.Simulation.bond`) to ``path``: one ``line`` cell per
+    bond between the two particles' centres, with cell data ``pair``,
+    ``normal_force`` (compression positive, tension negative), ``shear_force``
+    (magnitude) and ``moment`` (the bending moment's magnitude); the normal force also
+    as point data (a *Tube* by scalar, or colour by it)."""
+    b = sim.bonds.numpy()
+    p = sim.particles.numpy() if particles is None else particles
+    d = getattr(sim, "dim", 2)
+    pos = np.asarray(p["position"], dtype=np.float64).reshape(-1, d)
+    pairs = np.asarray(b["pairs"], dtype=np.int64).reshape(-1, 2)
+    m = len(pairs)
+    pts = np.empty((2 * m, d))
+    if m:
+        pts[0::2], pts[1::2] = pos[pairs[:, 0]], pos[pairs[:, 1]]
+    fn = np.asarray(b["normal_force"], dtype=np.float64)
+    mom = np.asarray(b["moment"], dtype=np.float64)
+    cell_data = {
+        "id": [np.arange(m, dtype=np.int64)], "pair": [pairs], "normal_force": [fn],
+        "shear_force": [np.linalg.norm(np.asarray(b["shear_force"], float).reshape(m, d), axis=1)],
+        "moment": [np.abs(mom) if d == 2 else np.linalg.norm(mom.reshape(m, 3), axis=1)],
+    }
+    _write_mesh(path, _xyz(pts), [("line", np.arange(2 * m, dtype=np.int64).reshape(-1, 2))],
+                point_data={"normal_force": np.repeat(fn, 2)}, cell_data=cell_data)
+    return path
+
+
+def write_cracks_vtu(sim, path):
+    """Broken bonds to ``path``: one ``vertex`` per crack at its contact point, with
+    point data ``id``, ``time`` (s), ``mode`` (0 tension, 1 shear), ``normal`` (the bond's
+    direction then), ``normal_force`` and ``shear_force`` at the break and ``energy``
+    (released)."""
+    c = sim.cracks.numpy()
+    k = len(c["time"])
+    point_data = {"id": np.arange(k, dtype=np.int64), "time": c["time"],
+                  "mode": c["mode"].astype(np.int64),
+                  "normal": _xyz(c["normal"]), "normal_force": c["normal_force"],
+                  "shear_force": c["shear_force"], "energy": c["energy"]}
+    _write_mesh(path, _xyz(c["position"]), [("vertex", np.arange(k, dtype=np.int64)[:, None])],
+                point_data=point_data)
+    return path
+
+
 def write_vtu(sim, path, walls=True, contacts=True):
     """Write one snapshot of ``sim``: particles to ``path``, and beside it the walls
     to ``<stem>_walls.vtu`` and the contacts to ``<stem>_contacts.vtu`` (see
@@ -488,6 +531,9 @@ def write_vtu(sim, path, walls=True, contacts=True):
     if contacts:
         written.append(str(write_contacts_vtu(sim, path.with_name(path.stem + "_contacts.vtu"),
                                               p)))
+    if getattr(sim, "_nbonds", 0):
+        written.append(str(write_bonds_vtu(sim, path.with_name(path.stem + "_bonds.vtu"), p)))
+        written.append(str(write_cracks_vtu(sim, path.with_name(path.stem + "_cracks.vtu"))))
     return written
 
 
@@ -654,6 +700,9 @@ class Output:
             names["walls"] = f"walls_{k:05d}.vtu"
         if self.contacts:
             names["contacts"] = f"contacts_{k:05d}.vtu"
+        if self._sim is not None and getattr(self._sim, "_nbonds", 0):
+            names["bonds"] = f"bonds_{k:05d}.vtu"
+            names["cracks"] = f"cracks_{k:05d}.vtu"
         return names
 
     @property
@@ -717,6 +766,9 @@ class Output:
             written.append(str(write_walls_vtu(sim, self.directory / names["walls"])))
         if self.contacts:
             written.append(str(write_contacts_vtu(sim, self.directory / names["contacts"], p)))
+        if "bonds" in names:
+            written.append(str(write_bonds_vtu(sim, self.directory / names["bonds"], p)))
+            written.append(str(write_cracks_vtu(sim, self.directory / names["cracks"])))
         self._entries.append((step, t, k))
         self._write_indices()
         return written

@@ -46,7 +46,8 @@ SCRIPT_NAME = "view.py"
 
 # the series a folder may hold, in drawing order, and the array whose value is >= 0
 # on every real cell (the placeholder of an empty file has -1 there)
-KINDS = ("elements", "blocks", "shapes", "particles", "couplings", "walls", "contacts")
+KINDS = ("elements", "blocks", "shapes", "particles", "couplings", "walls", "contacts",
+         "bonds", "cracks")
 
 # the default colour field of elements and blocks, and its unit
 DEFAULT_FIELD = "stress_yy"
@@ -351,7 +352,8 @@ AS_PROGRAM = bool(sys.argv) and os.path.basename(sys.argv[0]) == "view.py"
 # empty one), and whether it is point or cell data
 VALID = {"particles": ("POINTS", "id"), "walls": ("CELLS", "id"), "shapes": ("CELLS", "id"),
          "elements": ("CELLS", "owner"), "blocks": ("CELLS", "block"),
-         "couplings": ("CELLS", "kind")}
+         "couplings": ("CELLS", "kind"), "bonds": ("CELLS", "id"),
+         "cracks": ("POINTS", "id")}
 BARS = []          # the colour bars shown, top to bottom
 
 
@@ -686,6 +688,40 @@ def main():
             info["contacts"]["tube_bounds"] = bounds(tubes, t)
             info["contacts"]["tube_scale"] = scale
             shown["contacts"] = tubes
+
+    # bonds: lines coloured by their normal force (blue compression, red tension);
+    # cracks: dots coloured by mode (red tension, blue shear)
+    if "bonds" in readers:
+        src = threshold(readers["bonds"], "CELLS", "id", 0.0, "bonds_intact")
+        rep = Show(src, view)
+        flat(rep)
+        rep.LineWidth = 2.0
+        ColorBy(rep, ("CELLS", "normal_force"))
+        lut = GetColorTransferFunction("normal_force")
+        lut.ApplyPreset("Cool to Warm", True)
+        lut.InvertTransferFunction()
+        rng = array_range(src, "CELLS", "normal_force", t)
+        top = max(abs(rng[0]), abs(rng[1])) if rng else 1.0
+        lut.RescaleTransferFunction(-top, top)
+        colour_bar(view, lut, "bond normal force (%s)" % ("N" if DIM == 3 else "N/m"),
+                   not args.no_text)
+        shown["bonds"] = src
+        info["bonds"] = count(src, t)
+    if "cracks" in readers:
+        src = threshold(readers["cracks"], "POINTS", "id", 0.0, "cracks_valid")
+        rep = Show(src, view)
+        rep.SetRepresentationType("Points")
+        rep.PointSize = 6.0
+        try:
+            rep.RenderPointsAsSpheres = 1
+        except AttributeError:
+            pass
+        ColorBy(rep, ("POINTS", "mode"))
+        lut = GetColorTransferFunction("mode")
+        lut.ApplyPreset("Rainbow Uniform", True)
+        lut.RescaleTransferFunction(0.0, 1.0)
+        shown["cracks"] = src
+        info["cracks"] = count(src, t)
 
     # one scale for the field over elements and blocks: its 1st to 99th percentile (a
     # stress concentration at a corner does not wash out the rest), symmetric about 0

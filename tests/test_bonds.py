@@ -208,3 +208,26 @@ def test_bad_bond_input_is_named():
     with pytest.raises(tdem.InputError, match="gap"):
         sim.bond(g, tdem.ParallelBond(young=1e9), gap=-1.0)
     assert sim.bond(g, tdem.ParallelBond(young=1e9), gap=0.0) == 1   # touching: bonded
+
+
+def test_bonds_and_cracks_in_the_output_series(tmp_path):
+    """The series holds bonds.pvd (lines with their forces) and cracks.pvd (points
+    with time and mode), readable back, matching sim.bonds and sim.cracks."""
+    import meshio
+    sc = 2e5
+    pb = tdem.ParallelBond(young=E, stiffness_ratio=2.0, tensile_strength=sc)
+    sim, _ = _pair(2, pb)
+    sim.output(tmp_path, every=300, contacts=False)
+    _hold(sim, 2, v1=(0.05, 0.0, 0.0))
+    sim.run(steps=1200)                     # breaks at step 800 (u = 2R σ̄_c/Ē)
+    assert (tmp_path / "bonds.pvd").exists() and (tmp_path / "cracks.pvd").exists()
+    first = meshio.read(tmp_path / "bonds_00001.vtu")          # step 300: intact
+    assert len(first.cells[0].data) == 1
+    assert first.cell_data["normal_force"][0][0] < 0.0          # stretched: tension
+    last = meshio.read(tmp_path / "cracks_00004.vtu")           # step 1200: broken
+    c = sim.cracks.numpy()
+    np.testing.assert_allclose(last.point_data["time"], c["time"])
+    np.testing.assert_array_equal(last.point_data["mode"], c["mode"])
+    assert len(c["time"]) == 1
+    none = meshio.read(tmp_path / "bonds_00004.vtu")            # the placeholder
+    assert none.cell_data["id"][0][0] == -1
