@@ -1,4 +1,4 @@
-"""The rock of uniaxial_compression as parallel-bonded discs: uniaxial compression, a Brazilian test and the bonded-particle model's trends (Potyondy & Cundall 2004).
+"""The rock of uniaxial_compression as parallel-bonded discs and spheres: uniaxial compression, a Brazilian test and the bonded-particle model's trends (Potyondy & Cundall 2004).
 
 The rock of Feng, Li & Oñate (2015) §3.2 (``cases.uniaxial_compression``: E = 30 GPa,
 ν = 0.25, c = 3 MPa, T = 1 MPa, φ = 40°, ρ = 2500 kg/m³; its Mohr–Coulomb uniaxial
@@ -24,6 +24,10 @@ uncalibrated start a PFC user makes)
   closing at 2 × 0.005 m/s; σ_t = 2 P_max / (π D), P_max the peak force per metre.
 - Trends (P&C §4): the same sample with Ē and E_c doubled (E should double), and with
   σ̄_c and c̄ doubled (UCS should double).
+- Bonded spheres: a 0.05 × 0.05 × 0.1 m prism of spheres (radii 1.25 R_min to 1.66 ×
+  that, ``tdem.pack.random3d`` at 0.55 with overlaps below 5e-5 R_min), the same bonds,
+  contacts k_n = E_c π R̄/2 (PFC3D's E_c A/L, A = πR², L = 2R, at the mean radius),
+  between two square mesh platens: uniaxial compression and its strength trend.
 
 What is compared: the trends (within 5 % and 15 %), the ratio σ_t/σ_c beside the
 rock's T/UCS = 0.078 (P&C: the parallel bond overestimates it, ≈ 0.25 for their
@@ -50,6 +54,7 @@ SPEED = 0.005             # m/s, each platen
 RAMP = 1e-3               # s
 DAMPING = 0.7
 FRACTION = 0.80
+SIDE3D, HEIGHT3D, FRACTION3D = 0.05, 0.1, 0.55
 PRESETS = {"quick": {"rmin": 2e-3, "seed": 1}, "paper": {"rmin": 1e-3, "seed": 1}}
 
 
@@ -132,6 +137,62 @@ def uniaxial(cfg, opts, **scale):
             "xy": sim.particles.numpy()["position"], "steps": sim.steps, "dt": sim.dt}
 
 
+def specimen3d(cfg, opts, scale_modulus=1.0, scale_strength=1.0):
+    """Bonded spheres: a 0.05 × 0.05 × 0.1 m prism (radii R_min·1.25 to 1.66·that),
+    platens (square meshes) below and above. Returns (sim, top, bottom, height,
+    bonds made)."""
+    rmin = 1.25 * cfg["rmin"]
+    x, r = tdem.pack.random3d((0.0, 0.0, 0.0), (SIDE3D, SIDE3D, HEIGHT3D), rmin,
+                              1.66 * rmin, seed=cfg["seed"], target_fraction=FRACTION3D,
+                              overlap_tol=5e-5)
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), local_damping=DAMPING,
+                          progress=False, **opts)
+    ec = E_ROCK * scale_modulus
+    # PFC3D's k_n = E_c A/L, A = π R², L = 2R, at the mean radius
+    kn = ec * math.pi * float(np.mean(r)) / 2.0
+    contact = tdem.LinearContact(kn=kn, ks=kn / KAPPA, friction=0.5)
+    _, bond = laws(scale_modulus, scale_strength)
+    g = sim.add_particles(x, r, density=RHO, contact=contact)
+    made = sim.bond(g, bond, gap=0.05 * rmin)
+    a, b = -0.5 * SIDE3D, 1.5 * SIDE3D
+    v, t = tdem.surfaces.plane((0.5 * SIDE3D, 0.5 * SIDE3D, 0.0), (0.0, 0.0, 1.0), 2 * SIDE3D)
+    bottom = sim.add_mesh(v, t, contact=contact)
+    v2, t2 = tdem.surfaces.plane((0.5 * SIDE3D, 0.5 * SIDE3D, HEIGHT3D), (0.0, 0.0, -1.0),
+                                 2 * SIDE3D)
+    top = sim.add_mesh(v2, t2, contact=contact)
+    del a, b
+    return sim, top, bottom, HEIGHT3D, made
+
+
+def uniaxial3d(cfg, opts, **scale):
+    sim, top, bottom, h, made = specimen3d(cfg, opts, **scale)
+    rows, peak, every = [], 0.0, 100
+    while True:
+        v = _ramp(sim.time)
+        top.velocity = (0.0, 0.0, -v)
+        bottom.velocity = (0.0, 0.0, v)
+        sim.run(steps=every)
+        f = 0.5 * (top.force[2] - bottom.force[2])
+        strain = (rows[-1][0] if rows else 0.0) + 2 * v * every * sim.dt / h
+        rows.append((strain, f / SIDE3D ** 2, len(sim.cracks)))
+        peak = max(peak, rows[-1][1])
+        if strain >= 4e-3 or (peak > 0 and rows[-1][1] < 0.6 * peak
+                              and rows[-1][1] < rows[-2][1]):
+            break
+    hist = np.array(rows)
+    stress = hist[:, 1]
+    k = int(np.argmax(stress))
+    sel = (stress[:k + 1] >= 0.2 * stress[k]) & (stress[:k + 1] <= 0.5 * stress[k])
+    lo, hi = np.flatnonzero(sel)[[0, -1]] if sel.sum() >= 2 else (0, k)
+    c = sim.cracks.numpy()
+    return {"ucs": float(stress[k]),
+            "E": float((stress[hi] - stress[lo]) / (hist[hi, 0] - hist[lo, 0])),
+            "strain": hist[:, 0], "stress": stress, "particles": sim.n_particles,
+            "bonds": made, "cracks": len(c["time"]),
+            "tension_fraction": float(np.mean(c["mode"] == 0)) if len(c["mode"]) else None,
+            "steps": sim.steps, "dt": sim.dt}
+
+
 def brazilian(cfg, opts):
     sim, top, bottom, h, made = specimen(cfg, "disc", opts)
     hist = load(sim, top, bottom, h, max_strain=2e-2)
@@ -144,14 +205,18 @@ def brazilian(cfg, opts):
             "tension_fraction": float(np.mean(c["mode"] == 0)) if len(c["mode"]) else None}
 
 
-def plots(base, stiff, strong, braz, out):
+def plots(base, stiff, strong, braz, out, sph=None, sph2=None):
     plt = common.pyplot()
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4))
     for r, lab in ((base, "Ē = E_c = 30 GPa, σ̄_c = T, c̄ = c"), (stiff, "moduli × 2"),
                    (strong, "strengths × 2")):
         ax.plot(1e3 * r["strain"], r["stress"] / 1e6, label=lab)
-    top = max(float(r["stress"].max()) for r in (base, stiff, strong))
-    right = max(float(r["strain"][-1]) for r in (base, stiff, strong))
+    for r, lab in ((sph, "bonded spheres"), (sph2, "bonded spheres, strengths × 2")):
+        if r is not None:
+            ax.plot(1e3 * r["strain"], r["stress"] / 1e6, ls="-.", label=lab)
+    runs = [r for r in (base, stiff, strong, sph, sph2) if r is not None]
+    top = max(float(r["stress"].max()) for r in runs)
+    right = max(float(r["strain"][-1]) for r in runs)
     e = np.linspace(0, 1.1 * right, 5)
     ax.plot(1e3 * e, E_ROCK / (1 - NU ** 2) * e / 1e6, "k--", lw=0.8,
             label=f"rock's E/(1−ν²) (its UCS: {UCS_MC / 1e6:.2f} MPa)")
@@ -159,7 +224,7 @@ def plots(base, stiff, strong, braz, out):
     ax.set_ylim(0, 1.25 * top / 1e6)
     ax.set_xlabel("axial strain (‰)")
     ax.set_ylabel("axial stress (MPa)")
-    ax.set_title("Uniaxial compression of bonded discs", fontsize=10)
+    ax.set_title("Uniaxial compression of bonded discs and spheres", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     bx.plot(1e3 * braz["strain"], braz["force"] / 1e3)
@@ -198,7 +263,11 @@ def main(argv=None):
     strong = uniaxial(cfg, opts, scale_strength=2.0)
     print("Brazilian", flush=True)
     braz = brazilian(cfg, opts)
-    plots(base, stiff, strong, braz, out)
+    print("uniaxial, bonded spheres", flush=True)
+    sph = uniaxial3d(cfg, opts)
+    print("uniaxial, bonded spheres, strengths × 2", flush=True)
+    sph2 = uniaxial3d(cfg, opts, scale_strength=2.0)
+    plots(base, stiff, strong, braz, out, sph, sph2)
     ratio = braz["sigma_t"] / base["ucs"]
     checks = [
         common.check("trend.modulus", stiff["E"] / base["E"], 2.0, common.rel(0.05), "",
@@ -219,6 +288,15 @@ def main(argv=None):
         common.check("uniaxial.tension_cracks", base["tension_fraction"], None, None, "",
                      "share of the cracks in tension at the end (P&C: most)"),
     ]
+    checks += [
+        common.check("spheres.trend.strength", sph2["ucs"] / sph["ucs"], 2.0,
+                     common.rel(0.15), "", "bonded spheres: UCS with the strengths doubled "
+                     "over UCS"),
+        common.check("spheres.E", sph["E"], E_ROCK, None, "Pa",
+                     "bonded spheres: secant 20–50 % of the peak, beside the rock's E"),
+        common.check("spheres.UCS", sph["ucs"], UCS_MC, None, "Pa",
+                     "bonded spheres: the peak beside the rock's strength"),
+    ]
     checks.append(common.check(
         "calibration.strength_factor", UCS_MC / base["ucs"], None, None, "",
         "the factor on σ̄_c and c̄ that gives the rock's UCS (UCS ∝ the strengths, "
@@ -230,7 +308,9 @@ def main(argv=None):
             "moduli_x2": {k: stiff[k] for k in keep},
             "strengths_x2": {k: strong[k] for k in keep},
             "brazilian": {k: braz[k] for k in ("sigma_t", "P_max", "particles", "bonds",
-                                                "cracks", "tension_fraction")}}
+                                                "cracks", "tension_fraction")},
+            "spheres": {k: sph[k] for k in keep},
+            "spheres_strengths_x2": {k: sph2[k] for k in keep}}
     summary = common.summary(CASE, args.preset, checks, data, clock(), threads=args.threads,
                              paper=PAPER)
     common.write_summary(out, summary)
