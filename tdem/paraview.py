@@ -696,6 +696,8 @@ def main():
         rep = Show(src, view)
         flat(rep)
         rep.LineWidth = 2.0
+        if DIM == 2:
+            rep.Position = [0.0, 0.0, 0.02]          # over the discs
         ColorBy(rep, ("CELLS", "normal_force"))
         lut = GetColorTransferFunction("normal_force")
         lut.ApplyPreset("Cool to Warm", True)
@@ -711,15 +713,18 @@ def main():
         src = threshold(readers["cracks"], "POINTS", "id", 0.0, "cracks_valid")
         rep = Show(src, view)
         rep.SetRepresentationType("Points")
-        rep.PointSize = 6.0
+        rep.PointSize = 7.0
+        if DIM == 2:
+            rep.Position = [0.0, 0.0, 0.03]          # over the discs and the bonds
         try:
             rep.RenderPointsAsSpheres = 1
         except AttributeError:
             pass
         ColorBy(rep, ("POINTS", "mode"))
         lut = GetColorTransferFunction("mode")
-        lut.ApplyPreset("Rainbow Uniform", True)
+        lut.RGBPoints = [0.0, 0.85, 0.1, 0.1, 1.0, 0.1, 0.3, 0.9]   # tension red, shear blue
         lut.RescaleTransferFunction(0.0, 1.0)
+        colour_bar(view, lut, "crack mode (0 tension, 1 shear)", not args.no_text)
         shown["cracks"] = src
         info["cracks"] = count(src, t)
 
