@@ -231,3 +231,107 @@ def test_bonds_and_cracks_in_the_output_series(tmp_path):
     assert len(c["time"]) == 1
     none = meshio.read(tmp_path / "bonds_00004.vtu")            # the placeholder
     assert none.cell_data["id"][0][0] == -1
+
+
+def test_shear_stiffness_and_the_friction_term_of_the_shear_strength():
+    """Slid sideways without turning: F̄_s = k̄_s Ā u_s to 1e-9. Pressed first by a
+    normal stress σ and then slid: the bond breaks in shear when |F̄_s|/Ā reaches
+    c̄ + σ tan φ̄, within one step's increment."""
+    sim, _ = _pair(2)
+    v = 1e-3
+    _hold(sim, 2, v1=(0.0, v, 0.0))
+    sim.run(steps=300)
+    p = sim._a["bprop"].to_numpy()[0]
+    fs = sim.bonds.numpy()["shear_force"][0]
+    # the contact point travels at v/2 relative to... the second disc's centre moves at
+    # v, the contact point with it (no spin): Δu_s = v Δt per step, from the 2nd step
+    assert fs[1] == pytest.approx(-p[BP_KS_A] * v * DT * 299, rel=1e-9)
+    # shear strength with a normal stress
+    coh, phi = 1e5, 30.0
+    pb = tdem.ParallelBond(young=E, stiffness_ratio=2.0, cohesion=coh, friction_angle=phi)
+    sim, _ = _pair(2, pb)
+    vc = 0.02                                     # pressed: σ = Ē u/(2R) grows
+    vs = 0.05
+    _hold(sim, 2, v1=(-vc, vs, 0.0))
+    sim.run(steps=2000)
+    c = sim.cracks.numpy()
+    assert len(c["time"]) == 1 and c["mode"][0] == 1
+    area = 2 * R
+    sigma = c["normal_force"][0] / area
+    tau = c["shear_force"][0] / area
+    ks_area = E / (2 * R) / 2.0 * area
+    step = ks_area * vs * DT / area                # one step's shear stress increment
+    want = coh + sigma * math.tan(math.radians(phi))
+    assert sigma > 0.1 * coh                       # the friction term matters
+    assert want <= tau + 1e-9 * want and tau < want + 2.0 * step
+
+
+def test_cantilever_of_bonded_discs_bends_as_euler_bernoulli():
+    """A row of 21 bonded discs (R = 1 cm, 1 µm apart: only the bonds act), the first
+    held still, a tip load F on the last: the tip deflection F L³/(3 Ē Ī) (Ī = 2R̄³/3
+    per metre, L = 40 R) within 3 % once at rest, the shear part (F L/(k̄_s Ā) per
+    bond length) added."""
+    n, gap = 21, 1e-6
+    x = np.zeros((n, 2))
+    x[:, 0] = np.arange(n) * (2 * R + gap)
+    sim = tdem.Simulation(gravity=(0.0, 0.0), local_damping=0.7, progress=False)
+    g = sim.add_particles(x, R, density=2500.0, contact=LAW)
+    pb = tdem.ParallelBond(young=E, stiffness_ratio=1.0)
+    assert sim.bond(g, pb, gap=2 * gap) == n - 1
+    sim.fix_particles([0], vx=0.0, vy=0.0, omega=0.0)
+    force = -20.0                                        # N/m, down
+    sim.apply_force([n - 1], fy=force)
+    sim.run(until=1.0)
+    tip = sim.particles.numpy()["displacement"][n - 1, 1]
+    length = (n - 1) * (2 * R + gap)
+    ei = E * 2 * R ** 3 / 3
+    shear = abs(force) * (n - 1) / (E / (2 * R) * 2 * R)
+    want = abs(force) * length ** 3 / (3 * ei) + shear
+    assert abs(tip) == pytest.approx(want, rel=0.03)
+    assert abs(tip) < 0.05 * length                       # small deflection
+    # at rest: at its speed now the tip would move under 1 % of the deflection in 0.1 s
+    assert np.abs(sim.particles.numpy()["velocity"]).max() * 0.1 < 0.01 * abs(want)
+
+
+def test_bonded_bar_carries_its_wave_at_sqrt_e_over_rho():
+    """A bar of 200 bonded discs in a row, its end given a smooth velocity pulse: the
+    pulse's peak travels at sqrt(E_eff/ρ_eff), E_eff = Ē (the bond's axial stiffness
+    Ē Ā/(2R) over the section 2R, times the spacing 2R), ρ_eff = ρ π R²/(2R)² (the
+    discs' mass over the bar's), within 3 %."""
+    n = 200
+    x = np.zeros((n, 2))
+    x[:, 0] = np.arange(n) * 2 * R
+    sim = tdem.Simulation(gravity=(0.0, 0.0), local_damping=0.0, progress=False)
+    g = sim.add_particles(x, R, density=2500.0, contact=LAW)
+    sim.bond(g, tdem.ParallelBond(young=E, stiffness_ratio=1.0), gap=1e-9)
+    c = math.sqrt(E / (2500.0 * math.pi / 4))
+    width = 20 * 2 * R / c                                # the pulse spans 20 discs
+
+    def vx(t):
+        return 0.01 * math.sin(math.pi * t / width) ** 2 if t < width else 0.0
+    sim.fix_particles([0], vx=vx, vy=0.0, omega=0.0)
+    stations = [50, 150]
+    seen = {k: [] for k in stations}
+    dt = sim.dt
+    while sim.time < width + 170 * 2 * R / c:
+        sim.run(steps=5)
+        v = sim.particles.numpy()["velocity"][:, 0]
+        for k in stations:
+            seen[k].append((sim.time, v[k]))
+    peaks = [max(seen[k], key=lambda r: r[1])[0] for k in stations]
+    speed = (stations[1] - stations[0]) * 2 * R / (peaks[1] - peaks[0])
+    assert speed == pytest.approx(c, rel=0.03)
+    assert 5 * dt < 0.05 * (peaks[1] - peaks[0])          # the sampling is fine enough
+
+
+def test_work_account_closes_with_bonds():
+    """Bonded discs set moving: the work of every force (the bonds' with the contacts')
+    adds up to the change of the kinetic energy to round-off."""
+    sim = tdem.Simulation(gravity=(0.0, 0.0), progress=False, dt=DT, local_damping=0.0)
+    g = sim.add_particles([[0.0, 0.0], [2 * R, 0.0]], R, density=2500.0, contact=LAW,
+                          velocity=[[0.0, 0.0], [0.02, 0.01]], omega=[3.0, 0.0])
+    sim.bond(g, tdem.ParallelBond(young=E, stiffness_ratio=2.0), gap=1e-6)
+    sim.run(steps=5000)
+    w = sim.work()
+    assert abs(w["residual"]) < 1e-12 * max(abs(w["contacts"]), w["kinetic_change"], 1e-30)
+    assert abs(w["contacts"]) > 0.0
