@@ -478,9 +478,20 @@ _ACCOUNT_KEYS = ("dissipated", "boundary_work", "W_contacts", "W_continuum", "W_
 def remove_rows(sim, rows):
     """Remove the particles at ``rows`` (indices now) from a built DEM model: every
     per-particle array loses their rows, the others' contact lists are compacted (their
-    history kept) and renumbered, groups, prescribed velocities, loads and identities
-    follow; the energy they take away goes to the account's ``outflow``. Returns their
-    identities and masses."""
+    history kept) and renumbered, groups, prescribed velocities, loads, bonds and
+    identities follow; the energy they take away goes to the account's ``outflow``.
+    Returns their identities and masses."""
+    ids, masses, state, before = compact(sim, rows)
+    sim._rebuild_from(state)
+    close_account(sim, before)
+    return ids, masses
+
+
+def compact(sim, rows):
+    """The first half of :func:`remove_rows`: the host side updated and the device
+    state, downloaded, without the rows; (identities, masses, state, the account
+    before). The caller rebuilds from the state (adding particles to it first, if it
+    likes) and then calls :func:`close_account`."""
     rows = np.unique(np.asarray(rows, np.int64))
     n = sim._n
     keep = np.ones(n, bool)
@@ -531,12 +542,21 @@ def remove_rows(sim, rows):
     sim._fixes = [(new_index[ids], *vals) for ids, *vals in sim._fixes]
     sim._loads = [(new_index[ids], *vals) for ids, *vals in sim._loads]
     sim._n = int(keep.sum())
-    sim._rebuild_from(state)
+    return gone, masses, state, before
+
+
+def close_account(sim, before, ke_in=0.0):
+    """The second half of :func:`remove_rows`, once the arrays are rebuilt: what the
+    removed particles had booked kept in the sums, what they held (kinetic,
+    gravitational, their contact springs) into ``outflow``. ``ke_in``: the kinetic
+    energy of particles added in the same rebuild (their own ``ke_start``, taken
+    out)."""
     after = sim._account_now()
+    after["ke_start"] -= ke_in
+    after["ke_half"] -= ke_in
     off = sim._flow_offsets
     for k in _ACCOUNT_KEYS:
         off[k] = off.get(k, 0.0) + before[k] - after[k]
     lost = sum(before[k] - after[k] for k in ("kinetic", "gravitational", "elastic"))
     off["outflow"] = off.get("outflow", 0.0) + lost
     off["elastic_out"] = off.get("elastic_out", 0.0) + before["elastic"] - after["elastic"]
-    return gone, masses

@@ -196,6 +196,8 @@ class Simulation(Runner, Results):
         self._outlets = []         # tdem.flows.Outlet
         self._flow_offsets = {}    # the account's sums of particles removed (tdem.flows)
         self._placed_clear = False  # add_particles of an inserter's batch: no overlap checks
+        self._pending_state = None  # a flow event's state, rebuilt once (tdem.flows)
+        self._pending_new = []
         self._shaped_cache = None
         self._polys = []          # the distinct polyhedra (their index: the shape tables' row)
         self._nonconv_reported = 0
@@ -427,7 +429,9 @@ class Simulation(Runner, Results):
         if not np.isfinite(om).all():
             k = int(np.argmax(~np.isfinite(om)))
             raise InputError(f"omega must be finite: particle {k} has omega {float(om[k])!r}")
-        state = self._download() if self._built else None
+        pending = self._pending_state
+        state = pending if pending is not None else (self._download() if self._built
+                                                     else None)
         old = state["pos"] if state is not None else (
             np.concatenate(self._host["pos"]) if self._host["pos"] else np.zeros((0, self.dim)))
         # (an inserter's batch is placed clear of every particle: tdem.flows)
@@ -460,7 +464,10 @@ class Simulation(Runner, Results):
         self._n += n
         g = ParticleGroup(self, ids, contact, rho)
         self._groups.append(g)
-        if state is not None:
+        if pending is not None:
+            # (tdem.flows: one rebuild for a segment's removals and insertions)
+            self._pending_new.append((pos, vel, r, rho, law, shp, ang, om))
+        elif state is not None:
             self._rebuild_from(state, new_particles=(pos, vel, r, rho, law, shp, ang, om))
         return g
 
@@ -1028,8 +1035,9 @@ class Simulation(Runner, Results):
 
     def _flow_events(self, t_end):
         """Between run segments: outlets remove what is inside them, inserters place
-        what is due by ``t_end``."""
-        from .flows import remove_rows
+        what is due by ``t_end``; the arrays are rebuilt once for both."""
+        from .flows import close_account, compact
+        state = before = None
         if self._built and self._n:
             found = [(out, out.find()) for out in self._outlets if out.due(self._steps)]
             rows = np.concatenate([r for _, r in found]) if found else np.zeros(0, np.int64)
@@ -1041,33 +1049,48 @@ class Simulation(Runner, Results):
                     # (the engine's arrays keep one particle)
                     rows, owner = rows[:-1], owner[:-1]
                 if len(rows):
-                    ids, masses = remove_rows(self, rows)
+                    ids, masses, state, before = compact(self, rows)
                     for k, (out, _) in enumerate(found):
                         sel = owner == k
                         if sel.any():
                             out.record(ids[sel], self._time, masses[sel])
-        for ins in self._inserters:
-            got = ins.batch(t_end)
-            if got is None:
-                continue
-            x, r, turn, mass = got
-            kw = dict(density=ins.density, contact=ins.contact, velocity=ins.velocity)
-            if ins.shape is None:
-                kw["radius"] = r
-            else:
-                kw["shape"] = ins.shape
-                if turn is not None:
-                    kw["orientation" if self.dim == 3 else "angle"] = turn
-            self._placed_clear = True
-            try:
-                g = self.add_particles(x, **kw)
-            finally:
-                self._placed_clear = False
-            if not self._merge_last_groups(ins):
-                ins.group = g
-            ins.record(self._host["ident"][-1][-len(r):], self._time, mass)
-            self._flow_offsets["inflow"] = self._flow_offsets.get("inflow", 0.0) + (
-                self._inflow_energy(x, r, ins))
+        batches = [(ins, ins.batch(t_end)) for ins in self._inserters]
+        batches = [(ins, got) for ins, got in batches if got is not None]
+        if batches and self._built and state is None:
+            state = self._download()
+        self._pending_state = state
+        self._pending_new = []
+        ke_in = 0.0
+        try:
+            for ins, (x, r, turn, mass) in batches:
+                kw = dict(density=ins.density, contact=ins.contact, velocity=ins.velocity)
+                if ins.shape is None:
+                    kw["radius"] = r
+                else:
+                    kw["shape"] = ins.shape
+                    if turn is not None:
+                        kw["orientation" if self.dim == 3 else "angle"] = turn
+                self._placed_clear = True
+                try:
+                    g = self.add_particles(x, **kw)
+                finally:
+                    self._placed_clear = False
+                if not self._merge_last_groups(ins):
+                    ins.group = g
+                ins.record(self._host["ident"][-1][-len(r):], self._time, mass)
+                inflow, ke = self._inflow_energy(x, r, ins)
+                self._flow_offsets["inflow"] = self._flow_offsets.get("inflow", 0.0) + inflow
+                ke_in += ke
+        finally:
+            self._pending_state = None
+            new, self._pending_new = self._pending_new, []
+        if state is not None:
+            self._rebuild_from(state, new_particles=tuple(
+                np.concatenate([np.broadcast_to(b[k], (len(b[2]),) + np.shape(b[k])[1:])
+                                if np.ndim(b[k]) == 0 else b[k] for b in new])
+                for k in range(8)) if new else None)
+        if before is not None:
+            close_account(self, before, ke_in=ke_in)
 
     def _merge_last_groups(self, ins):
         """An inserter's batches make one group while nothing else is added between."""
@@ -1081,11 +1104,12 @@ class Simulation(Runner, Results):
         return True
 
     def _inflow_energy(self, x, r, ins):
-        """Kinetic and gravitational energy the inserted particles bring: ½ M v² − M g·x̄
-        (they start without spin and without contacts)."""
+        """(Kinetic and gravitational energy the inserted particles bring, ½ M v² −
+        Σ m g·x, and the kinetic part alone): they start without spin and contacts."""
         m = np.array([ins._mass_of(ri) for ri in r])
         g = np.asarray(self.gravity, float)[:self.dim]
-        return float(0.5 * m.sum() * ins.velocity @ ins.velocity - np.sum(m * (x @ g)))
+        ke = float(0.5 * m.sum() * ins.velocity @ ins.velocity)
+        return ke - float(np.sum(m * (x @ g))), ke
 
     def fix_particles(self, ids, vx=0.0, vy=None, omega=None, vz=None):
         """Prescribe velocity components of particles ``ids``.
