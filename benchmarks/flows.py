@@ -13,8 +13,8 @@ fall out of the open orifice into empty space). Reported: particle-steps per sec
 each, the time spent in the flow events (removal and insertion: a download and upload
 of the state each) per step and per event, the particles removed and inserted.
 
-    python benchmarks/flows.py --n 100000 --threads 2
-    python benchmarks/flows.py --n 20000 --threads 2 --steps 2000
+    python benchmarks/flows.py --n 100000 --threads 2 --steps 1000 --settle 600
+    python benchmarks/flows.py --n 100000 --threads 2 --steps 1000 --settle 600 --every 500
 """
 import argparse
 import math
@@ -61,6 +61,8 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--steps", type=int, default=3000)
     ap.add_argument("--settle", type=int, default=4000)
+    ap.add_argument("--every", type=int, default=None,
+                    help="steps between flow events (default: every check, 100 steps)")
     args = ap.parse_args()
     import tdem
     rows = {}
@@ -79,7 +81,7 @@ def main():
         plug.motion()
         out = ins = None
         if flows:
-            out = sim.remove_in(box=((-w, -w, -1.0), (w, w, -5 * D)))
+            out = sim.remove_in(box=((-w, -w, -1.0), (w, w, -5 * D)), every=args.every)
             # feed at the Beverloo estimate, C = 0.58, k = 1.5 (square orifice: its
             # hydraulic diameter 6 d), bulk density 0.6 × 2500
             dh = 2 * o
@@ -87,7 +89,8 @@ def main():
             ins = sim.insert(box=((-0.45 * w, -0.45 * w, height + 0.01),
                                   (0.45 * w, 0.45 * w, height + 0.05)),
                              rate=rate, grading=tdem.grading.uniform(0.9 * D, 1.1 * D),
-                             density=2500.0, contact=law, seed=1)
+                             density=2500.0, contact=law, seed=1,
+                             every=None if args.every is None else args.every * sim.dt)
         spent = [0.0, 0]
         if flows:
             orig = sim._flow_events

@@ -163,7 +163,8 @@ def _flows_from(sim, cfg, flows):
                        grading=None if d["grading"] is None else Grading.from_dict(d["grading"]),
                        density=d["density"], contact=sim._laws[d["law"]],
                        velocity=d["velocity"], orientation=d["orientation"],
-                       until=d["until"], seed=d["seed"])
+                       until=d["until"], seed=d["seed"], every=d.get("every"))
+        ins._last_batch = d.get("last_batch", -math.inf)
         ins.t0, ins.mass, ins.count = d["t0"], d["mass"], d["inserted"]
         ins._pending, ins._stopped = d["pending"], d["stopped"]
         ins._rng.bit_generator.state = d["rng"]

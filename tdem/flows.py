@@ -206,7 +206,7 @@ class Inserter:
 
     def __init__(self, sim, region, rate=None, count=None, per_s=None, radius=None,
                  grading=None, density=2500.0, contact=None, velocity=None, shape=None,
-                 orientation="random", until=None, seed=0):
+                 orientation="random", until=None, seed=0, every=None):
         dim = sim.dim
         self._sim = sim
         self.region = region
@@ -250,6 +250,8 @@ class Inserter:
         if shape is not None and not hasattr(shape, "bounding_radius"):
             raise InputError(f"shape must be a shape such as tdem.Superellipse, "
                              f"tdem.Ellipsoid or tdem.Polyhedron, got {shape!r}")
+        self.every = None if every is None else positive("every", every)
+        self._last_batch = -math.inf
         self.seed = int(seed)
         self._rng = np.random.default_rng(self.seed)
         self.t0 = float(sim.time)
@@ -315,6 +317,12 @@ class Inserter:
         if self.done:
             return None
         sim = self._sim
+        if self.every is not None:
+            # a batch every ``every`` seconds, holding what is due until the next
+            if sim.time < self._last_batch + self.every - 1e-12:
+                return None
+            self._last_batch = sim.time
+            t_end = max(t_end, sim.time + self.every)
         mass_due, num_due = self._due(t_end)
         old_x, old_r = sim._particles_near(self.region.lo, self.region.hi)
         from scipy.spatial import cKDTree
@@ -387,6 +395,7 @@ class Inserter:
                 "orientation": self.orientation, "until": self.until, "seed": self.seed,
                 "t0": self.t0, "mass": self.mass, "inserted": self.count,
                 "pending": self._pending, "stopped": self._stopped,
+                "every": self.every, "last_batch": self._last_batch,
                 "rng": self._rng.bit_generator.state}
 
     def __repr__(self):

@@ -906,7 +906,7 @@ class Simulation(Runner, Results):
 
     def insert(self, box=None, sphere=None, polygon=None, rate=None, count=None, per_s=None,
                radius=None, grading=None, density=2500.0, contact=None, velocity=None,
-               shape=None, orientation="random", until=None, seed=0):
+               shape=None, orientation="random", until=None, seed=0, every=None):
         """Insert particles during the run (pouring, pluviation, a feed): placed at
         random, without overlapping any particle, in a region — ``box`` (two corners;
         an axis of zero width makes it a plane: pluviation), ``sphere`` (centre,
@@ -920,7 +920,10 @@ class Simulation(Runner, Results):
         makes the draws repeatable.
 
         Particles are placed between run segments (every ``check_interval`` steps):
-        those due by the end of the coming segment. The region should be clear of
+        those due by the end of the coming segment; with ``every`` (s), a batch every
+        that long, holding what is due until the next (each placement rebuilds the
+        engine's arrays: about 1.5 s for 100,000 spheres on 2 cores, so a large model
+        is fed in fewer, larger batches). The region should be clear of
         walls. A particle that finds no room waits (a warning says so once). Returns an
         :class:`tdem.flows.Inserter` (``mass``, ``count``, ``ids``, ``times``,
         ``stop()``). Models with PCMM bodies or blocks take none."""
@@ -929,7 +932,8 @@ class Simulation(Runner, Results):
         region = Region(self.dim, box=box, sphere=sphere, polygon=polygon)
         ins = Inserter(self, region, rate=rate, count=count, per_s=per_s, radius=radius,
                        grading=grading, density=density, contact=contact, velocity=velocity,
-                       shape=shape, orientation=orientation, until=until, seed=seed)
+                       shape=shape, orientation=orientation, until=until, seed=seed,
+                       every=every)
         if shape is not None:
             self._check_polyhedral(shape, contact)
         self._inserters.append(ins)

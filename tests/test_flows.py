@@ -205,3 +205,17 @@ def test_2d_pluviation_from_a_line_and_a_polygon_outlet():
     # every one counted out, but the last: an outlet leaves a model its last particle
     assert out.count + sim.n_particles == 20 and sim.n_particles == 1
     assert out.region.contains(sim.particles.numpy()["position"]).all()
+
+
+def test_insertion_in_batches_every_so_often_keeps_the_rate():
+    """per_s = 200 with every = 0.05 s: batches of 10 at 0.05 s intervals (the mass due
+    until the next batch), 60 particles by 0.3 s, at six times."""
+    sim = tdem.Simulation(dim=3, progress=False)
+    sim.add_mesh(*FLOOR, contact=LAW)
+    ins = sim.insert(box=((0.0, 0.0, 0.15), (0.2, 0.2, 0.35)), per_s=200.0, radius=0.01,
+                     density=2500.0, contact=LAW, until=0.3, every=0.05, seed=2)
+    sim.run(until=0.32)
+    assert ins.count == 60
+    times = np.unique(ins.times)
+    assert len(times) == 6
+    np.testing.assert_allclose(np.diff(times), 0.05, atol=sim.check_interval * sim.dt)
