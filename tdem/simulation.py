@@ -289,6 +289,9 @@ class Simulation(Runner, Results):
         if any(p is not None for p in new) and self.broad_phase == "sweep":
             raise InputError("periodic: broad_phase='sweep' does not support periodic axes "
                              "(use broad_phase='grid')")
+        if any(p is not None for p in new) and self._nbonds:
+            raise InputError("periodic: a model with bonds cannot be periodic (bonds do "
+                             "not cross periodic boundaries)")
         if any(p is not None for p in new) and (self._slots or self._blocks):
             raise InputError("periodic: PCMM particles and blocks cannot be periodic (their "
                              "elements would span the boundary)")
@@ -968,7 +971,8 @@ class Simulation(Runner, Results):
         (:mod:`physics.parallel_bond`); it then leaves ``sim.bonds`` for
         ``sim.cracks``. Bonds are carried through neighbour rebuilds, growth,
         snapshots, replay, insertion, outlets and checkpoints. Returns the number of
-        bonds made. Not across periodic boundaries, nor between PCMM particles."""
+        bonds made. Discs and spheres only; not across periodic boundaries, nor between
+        PCMM particles."""
         from physics.parallel_bond import ParallelBond
         from .bonds import BS_WIDTH, pairs_within
         if not isinstance(law, ParallelBond):
@@ -985,6 +989,11 @@ class Simulation(Runner, Results):
                 np.concatenate([ids_a] + ([] if ids_b is None else [ids_b]))] >= 0).any():
             raise InputError("group: PCMM particles are joined by their elements; bonds "
                              "are for plain particles")
+        shp = np.concatenate(self._host["shape"])[
+            np.concatenate([ids_a] + ([] if ids_b is None else [ids_b]))]
+        if (shp[:, 2] > 0 if self.dim == 2 else shp[:, 3] != 0).any():
+            raise InputError("group: bonds join discs and spheres; shaped particles "
+                             "(superellipses, ellipsoids, polyhedra) take none")
         if self._built:
             state = self._download()
             pos, rad = state["pos"], state["prop"][:, 0]

@@ -208,6 +208,13 @@ def test_bad_bond_input_is_named():
     with pytest.raises(tdem.InputError, match="gap"):
         sim.bond(g, tdem.ParallelBond(young=1e9), gap=-1.0)
     assert sim.bond(g, tdem.ParallelBond(young=1e9), gap=0.0) == 1   # touching: bonded
+    with pytest.raises(tdem.InputError, match="periodic"):
+        sim.periodic(x=(-1.0, 1.0))
+    s2 = tdem.Simulation(progress=False)
+    e = s2.add_particles([[0.0, 0.0], [0.05, 0.0]], contact=LAW,
+                         shape=tdem.Superellipse(0.02, 0.01, 4))
+    with pytest.raises(tdem.InputError, match="shaped"):
+        s2.bond(e, tdem.ParallelBond(young=1e9), gap=0.02)
 
 
 def test_bonds_and_cracks_in_the_output_series(tmp_path):
