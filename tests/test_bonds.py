@@ -342,3 +342,24 @@ def test_work_account_closes_with_bonds():
     w = sim.work()
     assert abs(w["residual"]) < 1e-12 * max(abs(w["contacts"]), w["kinetic_change"], 1e-30)
     assert abs(w["contacts"]) > 0.0
+
+
+def test_bonds_between_two_groups_and_after_a_run():
+    """other=: only pairs with one particle in each group; bonds made after a run join
+    the arrays (the state carried) and act from the next step."""
+    sim = tdem.Simulation(gravity=(0.0, 0.0), progress=False, dt=DT)
+    x = np.zeros((4, 2))
+    x[:, 0] = np.arange(4) * 2 * R
+    a = sim.add_particles(x[:2], R, density=2500.0, contact=LAW)
+    b = sim.add_particles(x[2:], R, density=2500.0, contact=LAW)
+    pb = tdem.ParallelBond(young=E, stiffness_ratio=2.0)
+    sim.run(steps=5)
+    assert sim.bond(a, pb, other=b, gap=1e-6) == 1           # only 1–2 across the groups
+    assert sim.bonds.numpy()["pairs"].tolist() == [[1, 2]]
+    sim.fix_particles([0, 1], vx=0.0, vy=0.0, omega=0.0)
+    sim.fix_particles([2, 3], vx=1e-3, vy=0.0, omega=0.0)
+    sim.run(steps=100)
+    u = sim.particles.numpy()["position"][2, 0] - 4 * R - 1e-3 * DT
+    assert sim.bonds.numpy()["normal_force"][0] == pytest.approx(-E * u, rel=1e-9)
+    assert sim.bond(a, pb, gap=1e-6) == 1                    # 0–1 added to the list
+    assert len(sim.bonds) == 2
