@@ -37,7 +37,11 @@ from .validate import non_negative, positive
 BP_KN_A, BP_KS_A, BP_KN_I, BP_KS_J = 0, 1, 2, 3
 BP_D0, BP_RBAR, BP_AREA, BP_INERTIA, BP_POLAR = 4, 5, 6, 7, 8
 BP_SIGMA_C, BP_COHESION, BP_TANPHI = 9, 10, 11
-BP_WIDTH = 12
+# the kind of bond (0 a parallel bond, 1 a liquid bridge: physics.liquid_bridge) and a
+# liquid bridge's numbers
+BP_TYPE = 12
+BP_CAP_F0, BP_CAP_K, BP_RUPTURE = 13, 14, 15
+BP_WIDTH = 16
 
 
 class ParallelBond:

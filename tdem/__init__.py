@@ -17,6 +17,7 @@ from physics.linear import LinearContact
 from physics.volume_contact import VolumeContact
 from physics.rolling import RollingResistance
 from physics.parallel_bond import ParallelBond
+from physics.liquid_bridge import LiquidBridge
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 from physics.polyhedron import Polyhedron
 from physics.shapes import Ellipsoid, Superellipse
@@ -40,4 +41,5 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
-           "ensemble", "grading", "Grading", "motion", "TriaxialCell", "ParallelBond"]
+           "ensemble", "grading", "Grading", "motion", "TriaxialCell", "ParallelBond",
+           "LiquidBridge"]

@@ -17,9 +17,10 @@ import numpy as np
 import taichi as ti
 
 from physics.geometry.frame import moment, pack, spin_cross, vec_zero
-from physics.parallel_bond import (BP_AREA, BP_COHESION, BP_D0, BP_INERTIA, BP_KN_A,
-                                   BP_KN_I, BP_KS_A, BP_KS_J, BP_POLAR, BP_RBAR,
-                                   BP_SIGMA_C, BP_TANPHI)
+from physics.liquid_bridge import A1, A2
+from physics.parallel_bond import (BP_AREA, BP_CAP_F0, BP_CAP_K, BP_COHESION, BP_D0,
+                                   BP_INERTIA, BP_KN_A, BP_KN_I, BP_KS_A, BP_KS_J, BP_POLAR,
+                                   BP_RBAR, BP_RUPTURE, BP_SIGMA_C, BP_TANPHI, BP_TYPE)
 
 from .core.layout import PROP_RADIUS
 
@@ -36,7 +37,17 @@ BS_NORMAL = 16             # its normal then, from the first particle to the sec
 BS_RELEASED = 19           # its elastic energy then (J; J/m in 2D)
 BS_FN_BREAK = 20           # its normal force then
 BS_FS_BREAK = 21           # the magnitude of its shear force then
-BS_WIDTH = 22
+BS_MADE = 22               # a liquid bridge: the energy its making released, U(s₀)
+BS_POT = 23                # a liquid bridge: its potential energy −U(s) now
+BS_WIDTH = 24              # (tdem.state's ``bstate`` width)
+
+_Q = (4.0 * A2 - A1 * A1) ** 0.5
+
+
+@ti.func
+def _bridge_g(x):
+    """G(x) = (2/q) atan((2·A2 x + A1)/q), the integral of 1/(1 + A1 x + A2 x²)."""
+    return 2.0 / _Q * ti.atan2(2.0 * A2 * x + A1, _Q)
 
 
 @ti.func
@@ -62,7 +73,40 @@ def bond_forces(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
         i = bpair[b][0]
         j = bpair[b][1]
         s = bstate[b]
-        if i >= 0 and s[BS_BROKEN] == 0.0:
+        if i >= 0 and s[BS_BROKEN] == 0.0 and bprop[b][BP_TYPE] == 1.0:
+            # a liquid bridge (physics.liquid_bridge): Willett's force along the centres'
+            # line, pulling them together; it ruptures beyond Lian's distance
+            p = bprop[b]
+            d = pos[j] - pos[i]
+            dist = d.norm()
+            n = d / dist
+            ri = prop[i][PROP_RADIUS]
+            rj = prop[j][PROP_RADIUS]
+            gap = dist - ri - rj
+            if gap > p[BP_RUPTURE]:
+                bstate[b][BS_BROKEN] = 1.0
+                bstate[b][BS_TIME] = time
+                bstate[b][BS_MODE] = 2.0
+                xc = pos[i] + n * (ri + 0.5 * gap)
+                for k in ti.static(range(dim)):
+                    bstate[b][BS_POINT + k] = xc[k]
+                    bstate[b][BS_NORMAL + k] = n[k]
+                bstate[b][BS_RELEASED] = 0.0
+                bstate[b][BS_FN_BREAK] = bstate[b][BS_FN]
+                bstate[b][BS_FS_BREAK] = 0.0
+                bstate[b][BS_POT] = 0.0
+            else:
+                x = p[BP_CAP_K] * ti.max(gap, 0.0)
+                f = p[BP_CAP_F0] / (1.0 + A1 * x + A2 * x * x)
+                pot = p[BP_CAP_F0] / p[BP_CAP_K] * (
+                    _bridge_g(p[BP_CAP_K] * p[BP_RUPTURE]) - _bridge_g(x)) \
+                    + p[BP_CAP_F0] * ti.max(-gap, 0.0)
+                bstate[b][BS_FN] = -f
+                bstate[b][BS_POT] = -pot          # bound: below the ruptured state
+                fj = -f * n
+                bforce[j] += pack(fj, moment(n * 0.0, fj), dim)
+                bforce[i] += pack(-fj, moment(n * 0.0, fj), dim)
+        elif i >= 0 and s[BS_BROKEN] == 0.0:
             p = bprop[b]
             d = pos[j] - pos[i]
             dist = d.norm()
@@ -151,7 +195,11 @@ def bond_energy(bpair: ti.types.ndarray(), bprop: ti.types.ndarray(),
     for b in range(nbonds):
         s = bstate[b]
         p = bprop[b]
-        if bpair[b][0] >= 0 and s[BS_BROKEN] == 0.0:
+        if p[BP_TYPE] == 1.0:
+            # a liquid bridge: its potential, and the energy its making supplied
+            out[0] += s[BS_POT]
+            out[1] += s[BS_MADE]
+        elif bpair[b][0] >= 0 and s[BS_BROKEN] == 0.0:
             e = 0.5 * s[BS_FN] * s[BS_FN] / p[BP_KN_A]
             if p[BP_KS_A] > 0.0:
                 e += 0.5 * (s[BS_FS] ** 2 + s[BS_FS + 1] ** 2 + s[BS_FS + 2] ** 2) / p[BP_KS_A]

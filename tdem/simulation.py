@@ -966,17 +966,19 @@ class Simulation(Runner, Results):
     def bond(self, group, law, other=None, gap=0.0):
         """Bond the particles of ``group`` (indices, a group or a mask) whose surfaces
         are at most ``gap`` (m) apart — overlapping ones too — with ``law`` (a
-        :class:`tdem.ParallelBond`); with ``other``, only pairs of one particle from
-        each. A bond acts in parallel with the particles' contact law until it breaks
+        :class:`tdem.ParallelBond`, or a :class:`tdem.LiquidBridge`: wet grains); with
+        ``other``, only pairs of one particle from each. A bond acts in parallel with the particles' contact law until it breaks
         (:mod:`physics.parallel_bond`); it then leaves ``sim.bonds`` for
         ``sim.cracks``. Bonds are carried through neighbour rebuilds, growth,
         snapshots, replay, insertion, outlets and checkpoints. Returns the number of
         bonds made. Discs and spheres only; not across periodic boundaries, nor between
         PCMM particles."""
+        from physics.liquid_bridge import LiquidBridge
         from physics.parallel_bond import ParallelBond
         from .bonds import BS_WIDTH, pairs_within
-        if not isinstance(law, ParallelBond):
-            raise InputError(f"law must be a tdem.ParallelBond(...), got {law!r}")
+        if not isinstance(law, (ParallelBond, LiquidBridge)):
+            raise InputError(f"law must be a tdem.ParallelBond(...) or a "
+                             f"tdem.LiquidBridge(...), got {law!r}")
         g = non_negative("gap", gap)
         ids_a = indices("group", group, self._n)
         ids_b = None if other is None else indices("other", other, self._n)
@@ -1006,6 +1008,18 @@ class Simulation(Runner, Results):
         rows = {"bpair": np.stack([i, j], 1).astype(np.int32),
                 "bprop": law.properties(rad[i], rad[j], d0, self.dim),
                 "bstate": np.zeros((len(i), BS_WIDTH))}
+        if isinstance(law, LiquidBridge):
+            # its force and potential energy (−U) now; the energy its making releases
+            from physics.liquid_bridge import potential
+            from physics.parallel_bond import BP_CAP_F0, BP_CAP_K, BP_RUPTURE
+            from .bonds import BS_FN, BS_MADE, BS_POT
+            p = rows["bprop"]
+            gap0 = d0 - rad[i] - rad[j]
+            u0 = potential(gap0, p[:, BP_CAP_F0], p[:, BP_CAP_K], p[:, BP_RUPTURE])
+            x = p[:, BP_CAP_K] * np.maximum(gap0, 0.0)
+            rows["bstate"][:, BS_FN] = -p[:, BP_CAP_F0] / (1.0 + 2.1 * x + 10.0 * x * x)
+            rows["bstate"][:, BS_MADE] = u0
+            rows["bstate"][:, BS_POT] = -u0
         old = self._nbonds
         src = state if state is not None else self._bond_host
         for k, v in rows.items():
@@ -1285,15 +1299,27 @@ class Simulation(Runner, Results):
         that particle's inertia (the discs' and spheres' 0.5 and 0.4 m R²)."""
         if not self._nbonds:
             return np.inf
-        from physics.parallel_bond import BP_KN_A, BP_KN_I, BP_KS_A
+        from physics.parallel_bond import (BP_CAP_F0, BP_CAP_K, BP_KN_A, BP_KN_I, BP_KS_A,
+                                           BP_TYPE)
         src = self._a if self._built else None
         pair = (src["bpair"].to_numpy() if src else self._bond_host["bpair"])[:self._nbonds]
         prop = (src["bprop"].to_numpy() if src else self._bond_host["bprop"])[:self._nbonds]
         i, j = pair[:, 0], pair[:, 1]
+        bridge = prop[:, BP_TYPE] == 1.0
+        crit = np.inf
+        if bridge.any():
+            # a liquid bridge's stiffness: its force's steepest slope, 2.1 F₀ k
+            kb = 2.1 * prop[bridge, BP_CAP_F0] * prop[bridge, BP_CAP_K]
+            ib, jb = i[bridge], j[bridge]
+            ok = ib >= 0
+            if ok.any():
+                mb = np.minimum(m[ib[ok]], m[jb[ok]])
+                crit = float(np.min(2.0 * np.sqrt(mb / kb[ok])))
+        i, j, prop = i[~bridge], j[~bridge], prop[~bridge]
         ok = i >= 0
         i, j, prop = i[ok], j[ok], prop[ok]
         if not len(i):
-            return np.inf
+            return crit
         mm = np.minimum(m[i], m[j])
         rr = np.minimum(r[i], r[j])
         k = np.maximum(prop[:, BP_KN_A], prop[:, BP_KS_A])
@@ -1302,7 +1328,7 @@ class Simulation(Runner, Results):
         # a particle held by several bonds: the springs add; bounded by the bond count
         count = np.bincount(np.concatenate([i, j]), minlength=len(m))
         many = np.maximum(count[i], count[j])
-        return float(min(np.min(2.0 * np.sqrt(mm / (k * many))),
+        return float(min(crit, np.min(2.0 * np.sqrt(mm / (k * many))),
                          np.min(2.0 * np.sqrt(share * mm * rr ** 2 / (krot * many)))))
 
     def _inserted_probes(self):

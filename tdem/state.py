@@ -112,7 +112,7 @@ ENGINE = (
     Array("bpair", "bond", 2, "i32", "setup", fill=-1, doc="the bond's two particles"),
     Array("bprop", "bond", BP_WIDTH, "f64", "setup",
           doc="stiffnesses, cross-section, strengths (physics.parallel_bond.BP_*)"),
-    Array("bstate", "bond", 22, "f64", "dynamic",
+    Array("bstate", "bond", 24, "f64", "dynamic",
           doc="forces, moments; the crack once broken (tdem.bonds.BS_*)"),
     Array("bforce", "particle", "DS", "f", "scratch",
           doc="the bonds' forces and moments on each particle in a step"),

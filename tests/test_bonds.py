@@ -363,3 +363,70 @@ def test_bonds_between_two_groups_and_after_a_run():
     assert sim.bonds.numpy()["normal_force"][0] == pytest.approx(-E * u, rel=1e-9)
     assert sim.bond(a, pb, gap=1e-6) == 1                    # 0–1 added to the list
     assert len(sim.bonds) == 2
+
+
+# -- liquid bridges ----------------------------------------------------------
+def _bridged(dim, lb, r=1e-3):
+    sim = tdem.Simulation(gravity=(0.0,) * dim, progress=False, dt=1e-6, dim=dim,
+                          local_damping=0.0)
+    x = [[0.0] * dim, [2 * r] + [0.0] * (dim - 1)]
+    g = sim.add_particles(x, r, density=2500.0, contact=tdem.LinearContact(kn=1e4))
+    assert sim.bond(g, lb, gap=1e-9) == 1
+    _hold(sim, dim, v1=(0.02, 0.0, 0.0))
+    return sim
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_liquid_bridge_force_is_willetts_and_it_ruptures_at_lians_distance(dim):
+    """Two touching spheres (discs in 2D: a layer of spheres, force per metre F/(2R))
+    pulled apart at 0.02 m/s: the bridge pulls with Willett's F(s) = 2πRγ cos θ/(1 +
+    2.1 Ŝ + 10 Ŝ²), Ŝ = (s/2)sqrt(R/V), at every gap (to 1e-9), and ruptures at the first
+    step whose gap exceeds Lian's (1 + θ/2) V^(1/3)."""
+    r = 1e-3
+    lb = tdem.LiquidBridge(volume=2e-12, surface_tension=0.072, contact_angle=20.0)
+    s_rup = (1 + 0.5 * math.radians(20.0)) * 2e-12 ** (1 / 3)
+    assert lb.rupture_distance == pytest.approx(s_rup, rel=1e-12)
+    sim = _bridged(dim, lb, r)
+    v, dt = 0.02, sim.dt
+    per = 1.0 if dim == 3 else 1.0 / (2 * r)
+    for _ in range(6):
+        sim.run(steps=1000)
+        gap = sim.particles.numpy()["position"][1, 0] - 2 * r - v * dt     # at x_n
+        fn = sim.bonds.numpy()["normal_force"]
+        assert fn[0] == pytest.approx(-lb.bridge_force(gap, r, r) * per, rel=1e-9)
+        assert -fn[0] == pytest.approx(
+            per * 2 * math.pi * r * 0.072 * math.cos(math.radians(20.0))
+            / (1 + 2.1 * (gap / 2) * math.sqrt(r / 2e-12)
+               + 10 * ((gap / 2) * math.sqrt(r / 2e-12)) ** 2), rel=1e-9)
+    steps = int(math.ceil(s_rup / (v * dt))) + 50
+    sim.run(steps=steps)
+    assert len(sim.bonds) == 0
+    c = sim.cracks.numpy()
+    assert c["mode"][0] == 2
+    # the first step that starts with the gap beyond s_rup (the gap grows v Δt a step)
+    t_want = (math.floor(s_rup / (v * dt) + 1e-9) + 1) * dt
+    assert c["time"][0] == pytest.approx(t_want, abs=1.01 * dt)
+    assert np.abs(sim.particles.numpy()["force"]).max() == 0.0
+
+
+def test_liquid_bridge_energy_account_closes():
+    """The work done pulling the bridge apart is U(s₀) = ∫ F ds (its potential energy
+    −U(s) rises to 0 at rupture; its making released U(s₀), booked as dissipated): the
+    account closes to the Riemann sum's error (below 1e-3 of U(s₀))."""
+    r = 1e-3
+    lb = tdem.LiquidBridge(volume=2e-12)
+    sim = _bridged(3, lb, r)
+    sim.run(steps=1)
+    e0 = sim.energy()
+    u0 = -e0["elastic"]                    # bound: the potential energy is −U(s)
+    from physics.liquid_bridge import potential
+    f0 = 2 * math.pi * r * 0.072
+    k = 0.5 * math.sqrt(r / 2e-12)
+    assert u0 == pytest.approx(float(potential(0.0, f0, k, lb.rupture_distance)),
+                               rel=1e-3)
+    sim.run(steps=int(lb.rupture_distance / (0.02 * sim.dt)) + 100)
+    e = sim.energy()
+    assert len(sim.bonds) == 0 and e["elastic"] == pytest.approx(0.0, abs=1e-15)
+    # the pull's work: the bridge's potential and the pulled sphere's kinetic energy
+    assert e["boundary_work"] - e["kinetic"] == pytest.approx(u0, rel=2e-3)
+    assert abs(e["integration_error"]) < 1e-3 * u0
