@@ -1358,7 +1358,9 @@ class Simulation(Runner, Results):
         """(particles, law) for each law group present and each law its particles
         can meet (other groups' and walls')."""
         table = self._law_table()
-        wall_laws = {int(w[stepk.W_LAW]) for w in self._walls_host}
+        # (the law's column of a segment wall's row in 2D, of a mesh triangle's in 3D)
+        col = stepk.W_LAW if self.dim == 2 else stepk.T_LAW
+        wall_laws = {int(w[col]) for w in self._walls_host}
         present = np.unique(plaw)
         for law_id in present:
             sel = plaw == law_id
