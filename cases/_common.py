@@ -34,7 +34,7 @@ QUICK_WALL_S = {
     "contact_burst": 160, "water_blocks": 81, "plate_loading": 76,
     "ellipsoid_compression": 54, "impact_benchmarks": 24, "angle_of_repose": 503,
     "dam_break": 31, "bearing_capacity": 340, "rotating_drum": 62, "hopper_discharge": 74,
-    "bonded_rock": 52,
+    "bonded_rock": 52, "wet_column": 102,
 }
 QUICK_MEASURED = "measured with --threads 1 on 2 CPU cores, 2026-12-06"
 # quick-times:end

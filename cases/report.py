@@ -44,7 +44,7 @@ ORDER = ("nine_disc", "photoelastic", "biaxial", "triaxial_3d", "elastic_gravity
          "wave_bar", "bearing_capacity", "soil_cutting", "contact_burst", "water_blocks",
          "plate_loading",
          "ellipsoid_compression", "impact_benchmarks", "angle_of_repose", "dam_break",
-         "rotating_drum", "hopper_discharge", "bonded_rock")
+         "rotating_drum", "hopper_discharge", "bonded_rock", "wet_column")
 #: a few words on each case for the overview table
 WHAT = {
     "nine_disc": "nine discs compressed by four walls (Cundall & Strack)",
@@ -65,6 +65,7 @@ WHAT = {
     "dam_break": "a water column collapsing: its surge front (Martin & Moyce)",
     "rotating_drum": "a drum of spheres spun up: its regimes against the Froude number (Mellmann)",
     "bonded_rock": "rock as parallel-bonded discs: UCS, Brazilian, the BPM trends (Potyondy & Cundall)",
+    "wet_column": "wet spheres stand where dry ones slump: liquid bridges (Willett, Lian)",
     "hopper_discharge": "a bin emptying through a slot: flow rate against Beverloo's law",
 }
 
