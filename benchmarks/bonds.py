@@ -40,7 +40,7 @@ def specimen(dim, n, bonded, threads):
     top = float(x[:, -1].max()) + r
     if dim == 2:
         lo, hi = float(x[:, 0].min()) - 5 * r, float(x[:, 0].max()) + 5 * r
-        w1 = sim.add_wall((hi, -r), (lo, -r), contact=law)
+        sim.add_wall((hi, -r), (lo, -r), contact=law)
         w2 = sim.add_wall((lo, top), (hi, top), contact=law)
         w2.velocity = (0.0, -1e-3)
     else:
@@ -50,8 +50,6 @@ def specimen(dim, n, bonded, threads):
         v, t = tdem.surfaces.plane((c, c, top), (0.0, 0.0, -1.0), 3 * c + 10 * r)
         m = sim.add_mesh(v, t, contact=law)
         m.velocity = (0.0, 0.0, -1e-3)
-        w1 = None
-    del w1
     return sim, made
 
 

@@ -154,13 +154,11 @@ def specimen3d(cfg, opts, scale_modulus=1.0, scale_strength=1.0):
     _, bond = laws(scale_modulus, scale_strength)
     g = sim.add_particles(x, r, density=RHO, contact=contact)
     made = sim.bond(g, bond, gap=0.05 * rmin)
-    a, b = -0.5 * SIDE3D, 1.5 * SIDE3D
     v, t = tdem.surfaces.plane((0.5 * SIDE3D, 0.5 * SIDE3D, 0.0), (0.0, 0.0, 1.0), 2 * SIDE3D)
     bottom = sim.add_mesh(v, t, contact=contact)
     v2, t2 = tdem.surfaces.plane((0.5 * SIDE3D, 0.5 * SIDE3D, HEIGHT3D), (0.0, 0.0, -1.0),
                                  2 * SIDE3D)
     top = sim.add_mesh(v2, t2, contact=contact)
-    del a, b
     return sim, top, bottom, HEIGHT3D, made
 
 
