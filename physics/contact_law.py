@@ -39,6 +39,16 @@ A law is a subclass of :class:`ContactLaw` in a file of its own (the built-in on
   laws are thus written once for 2D and 3D: the engine's geometry function of the
   shape pair gives ``n``, ``u`` and the relative velocity, and the frame functions
   split it into ``vn`` and ``vt`` and turn ``ft`` back into a force.
+- ``range`` (optional): the name of one of its ``params`` that gives the distance
+  across which the law acts (m). Between discs and spheres such a law is also called
+  while the two are apart by less than that gap, with ``u`` = −gap ≤ 0 (and the
+  normal, arms and relative velocity of the frame at that distance); it decides
+  itself what acts there (its history tells it, e.g., whether a liquid bridge has
+  formed) and returns zero forces where nothing does. Beyond the range the contact's
+  history is cleared. The neighbour lists reach that much further, and
+  ``energy`` is called for such pairs too. Against walls and meshes a law acts while
+  the particle overlaps them only. A law without a range is called only while ``u``
+  > 0.
 
 A law defined in a user's script is registered and used exactly like a built-in one
 (no edit of the package); kernels compiled before a registration are recompiled for
@@ -52,7 +62,8 @@ The parameter table (one row per law used by a simulation, ``lawp``) has the col
 2     rolling model (1 elastic-perfectly plastic, 2 elastic-brittle Eq. 36, 3 the same
       with a permanent break)
 3     rolling damping on (1) or off (0)
-4…    the law's ``params``
+4     the law's range (m; 0: it acts only while the particles overlap)
+5…    the law's ``params``
 ====  ==========================================================
 
 and each contact slot's history vector holds the law's columns first, then the
@@ -71,11 +82,15 @@ from .validate import non_negative
 
 # columns of a row of the law table (the rolling ones are physics.rolling's)
 COL_CODE = 0
-COL_PARAMS = COL_ROLL_DAMP + 1
+COL_REACH = COL_ROLL_DAMP + 1      # the law's range (m): it acts across gaps below it
+COL_PARAMS = COL_REACH + 1
 ROLLING_COLUMNS = ("moment", "rotation", "broken")
 
 _REGISTRY = []           # law classes; a class's code is its index
 _BY_NAME = {}
+# built-in laws registered when first made (their history columns would widen every
+# simulation's contacts): name → module
+_ON_FIRST_USE = {"WetContact": "physics.wet_contact"}
 
 
 def register_law(cls):
@@ -98,6 +113,10 @@ def register_law(cls):
             raise InputError(f"{name}.{attr} must be a tuple of column names, got {v!r}")
     if len(cls.history) < 1:
         raise InputError(f"{name}.history must name at least the tangential spring column")
+    reach = getattr(cls, "range", None)
+    if reach is not None and reach not in cls.params:
+        raise InputError(f"{name}.range must name one of its params {cls.params} (the "
+                         f"distance in metres across which it acts), got {reach!r}")
     tang = getattr(cls, "tangential", ())
     if not isinstance(tang, tuple) or not set(tang) <= set(cls.history):
         raise InputError(f"{name}.tangential must be a tuple of names in its history "
@@ -133,6 +152,11 @@ def is_registered(cls):
 
 def law_class(name):
     """The registered law class of this name."""
+    if name not in _BY_NAME and name in _ON_FIRST_USE:
+        import importlib
+
+        cls = getattr(importlib.import_module(_ON_FIRST_USE[name]), name)
+        register_law(cls)
     try:
         return _BY_NAME[name]
     except KeyError:
@@ -203,6 +227,19 @@ class ContactLaw:
     history = ()
     tangential = ()
     rolling = None
+    range = None         # the name of the param that gives the law's range (m), if any
+
+    def acting_range(self):
+        """The distance (m) across which the law acts: the value of the param that
+        ``range`` names, 0 for a law that acts only while the particles overlap."""
+        name = type(self).range
+        if name is None:
+            return 0.0
+        v = self.values()[type(self).params.index(name)]
+        if not (v >= 0.0 and math.isfinite(v)):
+            raise InputError(f"{type(self).__name__}: its range {name!r} must be a "
+                             f"distance >= 0, got {v!r}")
+        return v
 
     def values(self):
         """Numbers of the parameter columns, in ``params`` order."""
@@ -218,7 +255,7 @@ class ContactLaw:
         if len(vals) != len(cls.params):
             raise InputError(f"{cls.__name__}.values() gave {len(vals)} numbers for the "
                              f"{len(cls.params)} params {cls.params}")
-        r = [float(cls.code)] + self._rolling_columns() + vals
+        r = [float(cls.code)] + self._rolling_columns() + [self.acting_range()] + vals
         if width is not None:
             r += [0.0] * (width - len(r))
         return r
@@ -297,6 +334,8 @@ class ContactLaw:
     def from_dict(d):
         d = dict(d)
         cls = law_class(d.pop("type"))
+        if hasattr(cls, "from_parts"):         # a law made of other objects
+            return cls.from_parts(d)
         if "rolling" in d:
             d["rolling"] = RollingResistance(**d["rolling"])
         return cls(**d)

@@ -25,6 +25,7 @@ per metre of thickness is F / (R_1 + R_2).
 import math
 
 import numpy as np
+import taichi as ti
 
 from tdem.core.errors import InputError
 
@@ -33,6 +34,23 @@ from .validate import non_negative, positive
 
 A1, A2 = 2.1, 10.0                       # Willett's Eq. 12
 _Q = math.sqrt(4.0 * A2 - A1 * A1)
+
+
+@ti.func
+def bridge_g(x):
+    """G(x) = (2/q) atan((2·A2 x + A1)/q), the integral of 1/(1 + A1 x + A2 x²)."""
+    return 2.0 / _Q * ti.atan2(2.0 * A2 * x + A1, _Q)
+
+
+@ti.func
+def willett(f0, k, s_rup, gap):
+    """(F, U) of a bridge at the gap ``gap`` (≤ s_rup; negative: overlapping): Willett's
+    F = F₀/(1 + A1 x + A2 x²), x = k·max(gap, 0), k = (1/2) sqrt(R/V), and the work
+    U = ∫_gap^{s_rup} F that separates it (:func:`potential`)."""
+    x = k * ti.max(gap, 0.0)
+    f = f0 / (1.0 + A1 * x + A2 * x * x)
+    u = f0 / k * (bridge_g(k * s_rup) - bridge_g(x)) + f0 * ti.max(-gap, 0.0)
+    return f, u
 
 
 class LiquidBridge:

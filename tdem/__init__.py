@@ -18,6 +18,7 @@ from physics.volume_contact import VolumeContact
 from physics.rolling import RollingResistance
 from physics.parallel_bond import ParallelBond
 from physics.liquid_bridge import LiquidBridge
+from physics.wet_contact import WetContact
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 from physics.polyhedron import Polyhedron
 from physics.shapes import Ellipsoid, Superellipse
@@ -42,4 +43,4 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
            "ensemble", "grading", "Grading", "motion", "TriaxialCell", "ParallelBond",
-           "LiquidBridge"]
+           "LiquidBridge", "WetContact"]

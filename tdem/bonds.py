@@ -17,7 +17,7 @@ import numpy as np
 import taichi as ti
 
 from physics.geometry.frame import moment, pack, spin_cross, vec_zero
-from physics.liquid_bridge import A1, A2
+from physics.liquid_bridge import A1, A2, bridge_g
 from physics.parallel_bond import (BP_AREA, BP_CAP_F0, BP_CAP_K, BP_COHESION, BP_D0,
                                    BP_INERTIA, BP_KN_A, BP_KN_I, BP_KS_A, BP_KS_J, BP_POLAR,
                                    BP_RBAR, BP_RUPTURE, BP_SIGMA_C, BP_TANPHI, BP_TYPE)
@@ -41,13 +41,6 @@ BS_MADE = 22               # a liquid bridge: the energy its making released, U(
 BS_POT = 23                # a liquid bridge: its potential energy −U(s) now
 BS_WIDTH = 24              # (tdem.state's ``bstate`` width)
 
-_Q = (4.0 * A2 - A1 * A1) ** 0.5
-
-
-@ti.func
-def _bridge_g(x):
-    """G(x) = (2/q) atan((2·A2 x + A1)/q), the integral of 1/(1 + A1 x + A2 x²)."""
-    return 2.0 / _Q * ti.atan2(2.0 * A2 * x + A1, _Q)
 
 
 @ti.func
@@ -99,7 +92,7 @@ def bond_forces(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                 x = p[BP_CAP_K] * ti.max(gap, 0.0)
                 f = p[BP_CAP_F0] / (1.0 + A1 * x + A2 * x * x)
                 pot = p[BP_CAP_F0] / p[BP_CAP_K] * (
-                    _bridge_g(p[BP_CAP_K] * p[BP_RUPTURE]) - _bridge_g(x)) \
+                    bridge_g(p[BP_CAP_K] * p[BP_RUPTURE]) - bridge_g(x)) \
                     + p[BP_CAP_F0] * ti.max(-gap, 0.0)
                 bstate[b][BS_FN] = -f
                 bstate[b][BS_POT] = -pot          # bound: below the ruptured state

@@ -124,8 +124,9 @@ class Results:
         cn = a["cn"].to_numpy()
         pos = a["pos"].to_numpy()
         r = a["prop"].to_numpy()[:, 0]
-        ii, kk = np.nonzero((cs[:, :, 2] > 0) & (np.arange(self._cap)[None, :] <
-                                                  a["ncnt"].to_numpy()[:, None]))
+        # in force: overlapping, or held across a gap by a law with a range
+        ii, kk = np.nonzero(((cs[:, :, 2] > 0) | (cs[:, :, 0] != 0))
+                            & (np.arange(self._cap)[None, :] < a["ncnt"].to_numpy()[:, None]))
         jj = nbr[ii, kk]
         u = cs[ii, kk, 2]
         normal_dir = cn[ii, kk]

@@ -184,6 +184,11 @@ class Runner:
     def _build(self):
         if self._n == 0 and not self._blocks:
             raise InputError("the simulation has no particles: call add_particles first")
+        if self._law_range > 0.0 and self._has_shapes:
+            law = next(law for law in self._laws if law.acting_range() > 0.0)
+            raise InputError(f"contact={law!r} acts across a gap (its range "
+                             f"{law.acting_range():g} m), which is built for discs and spheres; "
+                             f"this model has shaped particles")
         if self._slots:
             self._cont = self._new_continuum()
             for kind, ids, coef, block in self._nonreflect:
@@ -383,7 +388,7 @@ class Runner:
         return 4 * self._n + 1024
 
     def _grid_cells_for(self, pos, radius):
-        h = 2.0 * float(radius.max()) + self.skin
+        h = 2.0 * float(radius.max()) + self._list_skin()
         span = np.ptp(pos, axis=0) + 4 * h
         counts = np.ceil(span / h).astype(np.int64) + 1
         return int(max(min(np.prod(counts), self._cell_limit()), 1))
@@ -405,7 +410,7 @@ class Runner:
         lo, hi, rmax = b[:d], b[d:2 * d], b[2 * d]
         if not np.all(np.isfinite(b)) or hi[0] < lo[0]:
             return
-        h = 2.0 * rmax + self.skin
+        h = 2.0 * rmax + self._list_skin()
         if any(p is not None for p in self._periodic):
             self._fit_periodic_grid(lo, hi, h, force)
             return
@@ -596,9 +601,20 @@ class Runner:
         # (the chunk size itself goes up with the engine's parameters, _upload_params)
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
                            chunk=self._chunk() > 0, loads=bool(self._loads_on),
-                           bonds=self._nbonds > 0, detail=False,
+                           bonds=self._nbonds > 0, ranged=self._law_range > 0.0,
+                           detail=False,
                            continuum=False, laws=self._law_set, shapes=False,
                            dim=self.dim)[:-5]
+
+    @property
+    def _law_range(self):
+        """The longest range of the model's contact laws (m; 0: all act in contact only)."""
+        return max((law.acting_range() for law in self._laws), default=0.0)
+
+    def _list_skin(self):
+        """The neighbour lists' reach beyond contact: the skin, plus the laws' range, so
+        that a pair within range stays listed while no particle moves half a skin."""
+        return float(self.skin) + self._law_range
 
     def _chunk(self):
         """Particles per chunk of the step's pair loop (:func:`tdem.backend.chunk_size`),
@@ -659,9 +675,10 @@ class Runner:
         self._sync_triangle_bins()
         if self.broad_phase == "sweep":
             return schema.bind(sweep.rebuild, self._a, nwalls=len(self._walls_host),
-                               skin=float(self.skin), dim=self.dim)
+                               skin=self._list_skin(), dim=self.dim)
         return schema.bind(neighbors.rebuild, self._a, sorted_ids=self._a["sorted"],
-                           nwalls=len(self._walls_host), skin=float(self.skin), dim=self.dim)
+                           nwalls=len(self._walls_host), skin=self._list_skin(),
+                           dim=self.dim)
 
     def _one_step(self, step_args, rebuild_args, host_reads_flag, detail):
         """One time step: the stages in the order the data flows (Feng et al.'s seven

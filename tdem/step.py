@@ -15,7 +15,7 @@ Contact forces use x_n and the mid-step velocities v_{n−1/2} (C&S).
 """
 import taichi as ti
 
-from physics.contact_law import (get_columns, history_width, law_energy, law_force,
+from physics.contact_law import (COL_REACH, get_columns, history_width, law_energy, law_force,
                                  law_force_3d, law_stiffness, put_columns, tangent_dim,
                                  zero_history)
 from physics.geometry import disc_disc, disc_segment, sphere_triangle
@@ -70,12 +70,13 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
                  omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                  lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                  hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-                 detail, laws: ti.template(), per):
+                 detail, laws: ti.template(), per, ranged: ti.template()):
     """Contact in slot k of particle i (the owner, i < j) with partner j = nbr[i, k]:
     two discs (:func:`disc_pair`) or two spheres (:func:`sphere_pair`). xi, vi, wi,
     ri, mi, li are i's position, velocity, spin, radius, mass and law group; ``laws``
     the registered contact laws (:mod:`physics.contact_law`); ``per`` the periodic
-    axes (j is taken at its image nearest to i).
+    axes (j is taken at its image nearest to i); ``ranged`` (compile-time) whether a law
+    of the model acts across a gap (its range, :mod:`physics.contact_law`).
 
     Updates the history and returns (f_i, M_i, M_j, dissipated energy). With
     ``detail`` also stores the normal, the scalar forces and the overlap (for
@@ -87,11 +88,11 @@ def pair_contact(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templ
     if ti.static(xi.n == 2):
         f, m_on_i, m_on_j, diss = disc_pair(i, k, xi, vi, wi, ri, mi, li, pos, vel, omega,
                                             prop, plaw, lawp, lawpair, nbr, hist, cn, cs,
-                                            dt, detail, laws, per)
+                                            dt, detail, laws, per, ranged)
     else:
         f, m_on_i, m_on_j, diss = sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos, vel, omega,
                                               prop, plaw, lawp, lawpair, nbr, hist, cn, cs,
-                                              dt, detail, laws, per)
+                                              dt, detail, laws, per, ranged)
     return f, m_on_i, m_on_j, diss
 
 
@@ -100,7 +101,7 @@ def sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templa
                 omega: ti.template(), prop: ti.template(), plaw: ti.template(),
                 lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
                 hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-                detail, laws: ti.template(), per):
+                detail, laws: ti.template(), per, ranged: ti.template()):
     """:func:`pair_contact` of two spheres. The pair is tested on the squared distance
     first: of the listed pairs of a dense bed a third or more do not touch, and those
     cost a load of the partner's position and radius and no square root. The history
@@ -116,7 +117,13 @@ def sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templa
     m_on_i = ti.Vector([0.0, 0.0, 0.0])
     m_on_j = ti.Vector([0.0, 0.0, 0.0])
     diss = 0.0
-    if r2 < rs * rs:
+    cut = rs
+    L = 0
+    if ti.static(ranged):
+        # a law with a range acts across gaps below it
+        L = lawpair[li, plaw[j]]
+        cut = rs + lawp[L, COL_REACH]
+    if r2 < cut * cut:
         dist = ti.sqrt(r2)
         u = rs - dist
         n = ti.Vector([1.0, 0.0, 0.0])      # (coincident centres)
@@ -128,7 +135,8 @@ def sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templa
         aj = rj - 0.5 * u
         vrel = vel[j] - vi - (aj * omega[j] + ai * wi).cross(n)
         vn = vrel.dot(n)
-        L = lawpair[li, plaw[j]]
+        if ti.static(not ranged):
+            L = lawpair[li, plaw[j]]
         mj = pj[PROP_MASS]
         # R* = R_i R_j/(R_i + R_j) and m* = m_i m_j/(m_i + m_j) by one division
         inv = 1.0 / (rs * (mi + mj))
@@ -144,16 +152,23 @@ def sphere_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.templa
         m_on_j = aj * nxf
         diss = d1
         if ti.static(h.n >= R + 7):
-            # rolling resistance (the columns after the law's)
-            m, m_tot, th, brk, d2 = rolling_couple_3d(
-                lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - omega[j], n, dt,
-                get_columns(h, R, 3), get_columns(h, R + 3, 3), h[R + 6])
-            h = put_columns(h, R, m)
-            h = put_columns(h, R + 3, th)
-            h[R + 6] = brk
-            m_on_i += m_tot
-            m_on_j -= m_tot
-            diss += d2
+            # rolling resistance (the columns after the law's), while they touch
+            touching = 1
+            if ti.static(ranged):
+                touching = u > 0.0
+            if touching:
+                m, m_tot, th, brk, d2 = rolling_couple_3d(
+                    lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - omega[j], n, dt,
+                    get_columns(h, R, 3), get_columns(h, R + 3, 3), h[R + 6])
+                h = put_columns(h, R, m)
+                h = put_columns(h, R + 3, th)
+                h[R + 6] = brk
+                m_on_i += m_tot
+                m_on_j -= m_tot
+                diss += d2
+            else:
+                for c in ti.static(range(7)):
+                    h[R + c] = 0.0
         hist[i, k] = h
         if detail:
             cn[i, k] = n
@@ -172,7 +187,7 @@ def disc_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template
               omega: ti.template(), prop: ti.template(), plaw: ti.template(),
               lawp: ti.template(), lawpair: ti.template(), nbr: ti.template(),
               hist: ti.template(), cn: ti.template(), cs: ti.template(), dt,
-              detail, laws: ti.template(), per):
+              detail, laws: ti.template(), per, ranged: ti.template()):
     """:func:`pair_contact` of two discs. The history vector holds the law's columns,
     the rolling couple, rotation and broken flag (from column R) and the overlap
     offset u0 (the last column)."""
@@ -193,11 +208,18 @@ def disc_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template
     m_on_i = 0.0
     m_on_j = 0.0
     diss = 0.0
-    if u > 0.0:
+    live = u > 0.0
+    L = 0
+    if ti.static(ranged):
+        # a law with a range acts across gaps below it
+        L = lawpair[li, plaw[j]]
+        live = u > -lawp[L, COL_REACH]
+    if live:
         wj = omega[j]
         n, t, ai, aj, vrel = disc_disc.kinematics(d, dist, u, ri, rj, vi, vel[j], wi, wj)
         vn = vrel.dot(n)
-        L = lawpair[li, plaw[j]]
+        if ti.static(not ranged):
+            L = lawpair[li, plaw[j]]
         mj = pj[PROP_MASS]
         # R* = R_i R_j/(R_i + R_j) and m* = m_i m_j/(m_i + m_j) by one division
         inv = 1.0 / ((ri + rj) * (mi + mj))
@@ -206,15 +228,26 @@ def disc_pair(i, k, xi, vi, wi, ri, mi, li, pos: ti.template(), vel: ti.template
         fn_el, fn, ft, kn, cnd, d1, h = law_force(
             laws, lawp, L, u, vn, tangent_part(vrel, n), meff, reff, dt, h)
         fs_tot = ft[0]
-        m, m_tot, th, brk, d2 = rolling_couple(
-            lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
         f = -fn * n + tangent_vector(ft, n)
-        m_on_i = ai * fs_tot + m_tot
-        m_on_j = aj * fs_tot - m_tot
-        h[R] = m
-        h[R + 1] = th
-        h[R + 2] = brk
-        diss = d1 + d2
+        m_on_i = ai * fs_tot
+        m_on_j = aj * fs_tot
+        diss = d1
+        touching = 1
+        if ti.static(ranged):
+            touching = u > 0.0
+        if touching:
+            m, m_tot, th, brk, d2 = rolling_couple(
+                lawp, L, fn_el, kn, cnd, 2.0 * reff, wi - wj, dt, h[R], h[R + 1], h[R + 2])
+            m_on_i += m_tot
+            m_on_j -= m_tot
+            h[R] = m
+            h[R + 1] = th
+            h[R + 2] = brk
+            diss += d2
+        else:
+            h[R] = 0.0
+            h[R + 1] = 0.0
+            h[R + 2] = 0.0
         h[U0] = u0
         hist[i, k] = h
         if detail:
@@ -510,7 +543,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          fext: ti.types.ndarray(), lmom: ti.types.ndarray(), ptab: ti.types.ndarray(),
          pint: ti.types.ndarray(), bforce: ti.types.ndarray(), serial: ti.template(),
          chunk: ti.template(), loads: ti.template(), bonds: ti.template(),
-         detail: ti.i32, continuum: ti.template(), laws: ti.template(),
+         ranged: ti.template(), detail: ti.i32, continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
     """One step. ``detail`` (1 or 0) also stores what only output reads: per-contact
     normals, scalar forces and overlaps, particle forces, and the kinetic and
@@ -534,6 +567,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     ``bonds`` (compile-time): the bonds' forces and moments of this step (``bforce``,
     from :func:`tdem.bonds.bond_forces`) join the contact forces (their work is the
     contacts').
+
+    ``ranged`` (compile-time): a contact law of the model has a range, so that pairs of
+    discs or spheres apart by less than it are evaluated too (:mod:`physics.contact_law`).
 
     ``dim`` (compile-time): 2 (discs, superellipses, PCMM, segment walls) or 3 (spheres
     and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D.
@@ -663,7 +699,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                             fk, mk, mjk, dk = pair_contact(
                                 i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel,
                                 omega, prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail,
-                                laws, per)
+                                laws, per, ranged)
                     elif ti.static(shapes):
                         if shaped:
                             fk, mk, mjk, dk = shaped_pair(
@@ -674,11 +710,12 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                             fk, mk, mjk, dk = pair_contact(
                                 i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel,
                                 omega, prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail,
-                                laws, per)
+                                laws, per, ranged)
                     else:
                         fk, mk, mjk, dk = pair_contact(
                             i, k, xi, vi, wi, pi[PROP_RADIUS], pi[PROP_MASS], li, pos, vel, omega,
-                            prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws, per)
+                            prop, plaw, lawp, lawpair, nbr, hist, cn, cs, dt, detail, laws, per,
+                            ranged)
                 f += fk
                 tq += mk
                 diss += dk
@@ -1156,10 +1193,11 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
         ri = prop[i][PROP_RADIUS]
         for k in range(ncnt[i]):
             u = cs[i, k][2]
-            if u > 0.0:
-                j = nbr[i, k]
+            j = nbr[i, k]
+            L = lawpair[plaw[i], plaw[j]]
+            # (a law with a range stores energy across a gap too)
+            if u > 0.0 or u > -lawp[L, COL_REACH]:
                 rj = prop[j][PROP_RADIUS]
-                L = lawpair[plaw[i], plaw[j]]
                 h = hist[i, k]
                 reff = ri * rj / (ri + rj)
                 if ti.static(dim == 2):
@@ -1169,13 +1207,14 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                     if h[R + 3] > 0.0:       # an ellipsoid pair's R* (tdem.shaped3d)
                         reff = h[R + 3]
                 total += law_energy(laws, lawp, L, u, reff, h, T)
-                if ti.static(dim == 2):
-                    kn = law_stiffness(laws, lawp, L, u, reff)
-                    total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
-                elif ti.static(h.n >= R + 7):
-                    kn = law_stiffness(laws, lawp, L, u, reff)
-                    total += rolling_energy_3d(lawp, L, kn, get_columns(h, R, 3),
-                                               2.0 * ri * rj / (ri + rj))
+                if u > 0.0:           # (the rolling spring acts while they touch)
+                    if ti.static(dim == 2):
+                        kn = law_stiffness(laws, lawp, L, u, reff)
+                        total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri * rj / (ri + rj))
+                    elif ti.static(h.n >= R + 7):
+                        kn = law_stiffness(laws, lawp, L, u, reff)
+                        total += rolling_energy_3d(lawp, L, kn, get_columns(h, R, 3),
+                                                   2.0 * ri * rj / (ri + rj))
         for s in range(wid.shape[1]):
             w = wid[i, s]
             if w >= 0:
@@ -1224,7 +1263,7 @@ def particle_stress(prop: ti.types.ndarray(), angle: ti.types.ndarray(),
         s = ti.Matrix([[0.0, 0.0], [0.0, 0.0]])
         for k in range(ncnt[i]):
             u = cs[i, k][2]
-            if u > 0.0:
+            if u > 0.0 or cs[i, k][0] != 0.0:      # (a law with a range: across a gap)
                 c = cf[i, k]
                 n = cn[i, k]
                 s += _arm(shaped, si, ci, sni, ri, n, u).outer_product(ti.Vector([c[0], c[1]]))
@@ -1233,7 +1272,7 @@ def particle_stress(prop: ti.types.ndarray(), angle: ti.types.ndarray(),
             j = flat >> bits
             k = flat & (cap - 1)
             u = cs[j, k][2]
-            if u > 0.0:
+            if u > 0.0 or cs[j, k][0] != 0.0:
                 c = cf[j, k]
                 # the normal from i is −n, the force on i −f_owner
                 s -= _arm(shaped, si, ci, sni, ri, -cn[j, k], u).outer_product(
