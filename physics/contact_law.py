@@ -334,8 +334,8 @@ class ContactLaw:
     def from_dict(d):
         d = dict(d)
         cls = law_class(d.pop("type"))
-        if hasattr(cls, "from_parts"):         # a law made of other objects
-            return cls.from_parts(d)
+        if hasattr(cls, "_from_parts"):        # a law made of other objects
+            return cls._from_parts(d)
         if "rolling" in d:
             d["rolling"] = RollingResistance(**d["rolling"])
         return cls(**d)

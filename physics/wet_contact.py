@@ -114,7 +114,7 @@ class WetContact(ContactLaw):
                 "bridge": self.bridge.to_dict()}
 
     @classmethod
-    def from_parts(cls, d):
+    def _from_parts(cls, d):
         return cls(ContactLaw.from_dict(d["dry"]), LiquidBridge.from_dict(d["bridge"]))
 
     def __repr__(self):
