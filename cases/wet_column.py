@@ -25,12 +25,15 @@ Set-up (our choices)
   overlap) and settled under gravity for 0.4 s.
 - Bridges: V = 8e-12 m³ (0.2 % of a sphere's volume: pendular), γ = 0.072 N/m (water),
   θ = 0; made between spheres within the rupture distance V^(1/3) = 0.1 d.
+- Bridges made at contact (``tdem.WetContact``, the same bridge and dry law): every two
+  spheres that touch while settling or slumping are joined, and a slumping column makes
+  new bridges as it goes (the walls keep the dry law). Compared beside the bonded ones.
 - The sides are moved away at 1 m/s; the column is watched for 0.5 s. Its height: the
   98th percentile of the spheres' tops.
 
 Checks: the dry column of 4 d loses more than a third of its height; the wet one of
-4 d keeps more than 90 %, and 4 d is below 0.6 H_c; reported: the wet one of 20 d
-(above H_c) and the estimate.
+4 d keeps more than 90 % (bridges made once, and made at contact), and 4 d is below
+0.6 H_c; reported: the wet ones of 20 d (above H_c) and the estimate.
 """
 import math
 
@@ -49,9 +52,12 @@ MU = 0.5
 PHI = 25.0
 VOL, GAMMA = 8e-12, 0.072
 SIDE = 10 * D
-PRESETS = {"quick": {"heights": (4, 4, 20), "wet": (False, True, True), "watch": 0.5},
-           "paper": {"heights": (4, 4, 8, 12, 20, 30), "wet": (False,) + (True,) * 5,
-                     "watch": 1.0}}
+# wet: False (dry), "bond" (bridges made once, after settling, by sim.bond) or
+# "contact" (tdem.WetContact: a bridge at every contact, made during the run)
+PRESETS = {"quick": {"heights": (4, 4, 20, 4, 20),
+                     "wet": (False, "bond", "bond", "contact", "contact"), "watch": 0.5},
+           "paper": {"heights": (4, 4, 8, 12, 20, 30, 4, 12, 20, 30),
+                     "wet": (False,) + ("bond",) * 5 + ("contact",) * 4, "watch": 1.0}}
 
 
 def estimate(porosity, coordination):
@@ -71,7 +77,10 @@ def column(height_d, wet, opts, seed=1, watch=0.5):
                               seed=seed, target_fraction=0.5)
     sim = tdem.Simulation(dim=3, local_damping=0.3, progress=False, **opts)
     law = tdem.LinearContact(kn=KN, friction=MU, restitution=0.3)
-    g = sim.add_particles(x, r, density=RHO, contact=law)
+    lb = tdem.LiquidBridge(volume=VOL, surface_tension=GAMMA)
+    # the walls keep the dry law: no bridges to walls
+    g = sim.add_particles(x, r, density=RHO,
+                          contact=tdem.WetContact(law, lb) if wet == "contact" else law)
     v, t = tdem.surfaces.plane((0.5 * SIDE, 0.5 * SIDE, 0.0), (0, 0, 1), 20 * SIDE)
     sim.add_mesh(v, t, contact=law)
     sides = []
@@ -84,8 +93,9 @@ def column(height_d, wet, opts, seed=1, watch=0.5):
     vol = 4 / 3 * math.pi * np.sum(p["radius"] ** 3)
     top0 = float(np.percentile(p["position"][:, 2] + p["radius"], 98))
     porosity = 1 - vol / (SIDE * SIDE * top0)
-    lb = tdem.LiquidBridge(volume=VOL, surface_tension=GAMMA)
-    bridges = sim.bond(g, lb, gap=lb.rupture_distance) if wet else 0
+    bridges = sim.bond(g, lb, gap=lb.rupture_distance) if wet == "bond" else 0
+    if wet == "contact":
+        bridges = _contact_bridges(sim)
     for m, nrm in sides:
         m.velocity = tuple(-1.0 * nrm)                     # away from the column
     sim.run(until=sim.time + 0.05)
@@ -94,11 +104,20 @@ def column(height_d, wet, opts, seed=1, watch=0.5):
     sim.run(until=sim.time + watch)
     p = sim.particles.numpy()
     top = float(np.percentile(p["position"][:, 2] + p["radius"], 98))
-    return {"height_d": height_d, "wet": wet, "particles": sim.n_particles,
-            "porosity": porosity, "bridges_made": bridges, "bridges_left": len(sim.bonds),
+    left = len(sim.bonds) if wet == "bond" else _contact_bridges(sim) if wet else 0
+    return {"height_d": height_d, "wet": bool(wet), "bridges": wet or None,
+            "particles": sim.n_particles,
+            "porosity": porosity, "bridges_made": bridges, "bridges_left": left,
             "coordination": 2.0 * bridges / sim.n_particles,
             "top_before": top0, "top_after": top, "kept": top / top0,
             "x": p["position"][:, 0].tolist(), "z": p["position"][:, 2].tolist()}
+
+
+def _contact_bridges(sim):
+    """Bridges of a WetContact model now: its pairs of spheres in force (every pair that
+    has touched holds one until it ruptures)."""
+    pairs = sim.contacts.numpy()["pairs"]
+    return int(np.count_nonzero(pairs[:, 1] >= 0))
 
 
 def plots(runs, h_c, out):
@@ -106,10 +125,11 @@ def plots(runs, h_c, out):
     fig, axes = plt.subplots(1, len(runs), figsize=(3.2 * len(runs), 4.2), sharey=True)
     for a, r in zip(np.atleast_1d(axes), runs):
         a.scatter(1e3 * np.asarray(r["x"]), 1e3 * np.asarray(r["z"]), s=2,
-                  color="C0" if r["wet"] else "C1")
+                  color={None: "C1", "bond": "C0", "contact": "C2"}[r["bridges"]])
         a.axhline(1e3 * r["top_before"], color="k", lw=0.8, ls=":")
         a.axhline(1e3 * h_c, color="C3", lw=0.8, ls="--")
-        a.set_title(f"{'wet' if r['wet'] else 'dry'}, {r['height_d']} d: "
+        kind = {None: "dry", "bond": "wet (bonded)", "contact": "wet (at contact)"}
+        a.set_title(f"{kind[r['bridges']]}, {r['height_d']} d:\n"
                     f"keeps {100 * r['kept']:.0f} %", fontsize=9)
         a.set_xlabel("x (mm)")
         a.set_xlim(-30, 50)
@@ -128,15 +148,17 @@ def main(argv=None):
     opts = common.sim_options(args)
     runs = []
     for hd, wet in zip(cfg["heights"], cfg["wet"]):
-        print(f"{'wet' if wet else 'dry'} column, {hd} d", flush=True)
+        print(f"{'dry' if not wet else 'wet (' + wet + ')'} column, {hd} d", flush=True)
         runs.append(column(hd, wet, opts, watch=cfg["watch"]))
-    wets = [r for r in runs if r["wet"]]
+    wets = [r for r in runs if r["bridges"] == "bond"]
     sigma_t, c, h_c = estimate(float(np.mean([r["porosity"] for r in wets])),
                                float(np.mean([r["coordination"] for r in wets])))
     plots(runs, h_c, out)
     dry = next(r for r in runs if not r["wet"])
-    wet10 = next(r for r in runs if r["wet"] and r["height_d"] == 4)
-    tall = [r for r in runs if r["wet"] and r["height_d"] * D > h_c]
+    wet10 = next(r for r in runs if r["bridges"] == "bond" and r["height_d"] == 4)
+    tall = [r for r in runs if r["bridges"] == "bond" and r["height_d"] * D > h_c]
+    contact = [r for r in runs if r["bridges"] == "contact"]
+    c4 = next((r for r in contact if r["height_d"] == 4), None)
     checks = [
         common.check("dry.slumps", dry["kept"], None, common.between(max=2 / 3), "",
                      "the dry 4 d column's height kept (a third lost at least)"),
@@ -151,6 +173,16 @@ def main(argv=None):
     ] + [common.check(f"wet_{r['height_d']}d.kept", r["kept"], None, None, "",
                       f"a wet column of {r['height_d']} d ({r['height_d'] * D * 1e3:.0f} mm, "
                       f"above H_c): the height it keeps") for r in tall]
+    if c4 is not None:
+        checks.append(common.check(
+            "wet_contact.stands", c4["kept"], 1.0, common.between(min=0.9), "",
+            f"the wet 4 d column with bridges made at contact (tdem.WetContact, "
+            f"{c4['coordination']:.1f} a sphere): the height it keeps"))
+    checks += [common.check(
+        f"wet_contact_{r['height_d']}d.kept", r["kept"], None, None, "",
+        f"bridges made at contact, {r['height_d']} d: the height kept (the slump makes new "
+        f"bridges; {r['bridges_left']} held at the end, {r['bridges_made']} before)")
+        for r in contact if r["height_d"] * D > h_c]
     data = {"preset": {k: list(v) if isinstance(v, tuple) else v for k, v in cfg.items()},
             "estimate": {"sigma_t_Pa": sigma_t, "cohesion_Pa": c, "H_c_m": h_c, "phi": PHI},
             "runs": [{k: v for k, v in r.items() if k not in ("x", "z")} for r in runs]}
