@@ -46,8 +46,8 @@ A law is a subclass of :class:`ContactLaw` in a file of its own (the built-in on
   itself what acts there (its history tells it, e.g., whether a liquid bridge has
   formed) and returns zero forces where nothing does. Beyond the range the contact's
   history is cleared. The neighbour lists reach that much further, and
-  ``energy`` is called for such pairs too. Against walls and meshes a law acts while
-  the particle overlaps them only. A law without a range is called only while ``u``
+  ``energy`` is called for such pairs too. Against segment walls and sphere–mesh
+  contacts the same holds (R* = R_i). A law without a range is called only while ``u``
   > 0.
 
 A law defined in a user's script is registered and used exactly like a built-in one

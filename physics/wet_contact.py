@@ -11,7 +11,7 @@ force pulls the centres together, F₀ while they overlap and
     F(s) = F₀ / (1 + 2.1 Ŝ + 10 Ŝ²),   Ŝ = (s/2) sqrt(R/V),   F₀ = 2πRγ cos θ,
 
 across a gap s, R = 2R* (the Derjaguin radius: 2R₁R₂/(R₁ + R₂) for two spheres, 2R_i
-against a plane), until the gap exceeds Lian et al.'s (1993) rupture distance
+against a wall or mesh), until the gap exceeds Lian et al.'s (1993) rupture distance
 s_rup = (1 + θ/2) V^(1/3), the law's range. Two particles that come within range
 without touching are not joined (a bridge needs the liquid films to meet).
 
@@ -20,12 +20,13 @@ bridge pulls the grains together: the contact force that friction depends on gro
 what it pulls). The bridge's potential energy −U(s), U(s) = ∫_s^{s_rup} F, is in
 ``elastic``; the energy its forming releases, U at that step, is booked as dissipated,
 so that the account stays closed (as for :meth:`tdem.Simulation.bond`'s bridges). In
-2D a disc stands for a sphere of its radius in a layer one sphere thick, of
-thickness 4R* (R₁ + R₂ for equal discs): the force per metre is F/(4R*) = πγ cos θ
-while they touch.
+2D a disc stands for a sphere of its radius in a layer of thickness 4R* (R₁ + R₂ for
+equal discs; 4R_i against a wall): the force per metre is F/(4R*) = πγ cos θ while
+they touch.
 
-Against walls and meshes the law acts while the particle overlaps them, as its dry
-law with the bridge's F₀: a bridge to a wall is not modelled across a gap.
+Against walls and meshes of this law the same holds, with R* = R_i: a particle that
+touches one is wetted and held across the gap to the rupture distance. Give the walls
+a dry law for no bridges to them.
 """
 import math
 

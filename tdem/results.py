@@ -132,7 +132,7 @@ class Results:
         normal_dir = cn[ii, kk]
         wcs = a["wcs"].to_numpy()
         wid = a["wid"].to_numpy()
-        wi, wk = np.nonzero((wid >= 0) & (wcs[:, :, 2] > 0))
+        wi, wk = np.nonzero((wid >= 0) & ((wcs[:, :, 2] > 0) | (wcs[:, :, 0] != 0)))
         wu = wcs[wi, wk, 2]
         wn = a["wcn"].to_numpy()[wi, wk]
         pts = pos[ii] + self._arms(ii, normal_dir, u, r)

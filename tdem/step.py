@@ -268,12 +268,13 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
                   wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
                   laws: ti.template(), angle: ti.template(), shp: ti.template(),
-                  flags: ti.template(), shapes: ti.template()):
+                  flags: ti.template(), shapes: ti.template(), ranged: ti.template()):
     """Contacts of particle i with its candidate walls (listed in its wall slots by the
     neighbour build). The wall is 'j', of infinite radius and mass; what it receives
     is added to its sum in row ``row`` of ``wpart`` (the chunk's). Returns
     (force on i, moment on i, dissipation, work done by the walls). The history holds
-    the law's columns, then the rolling couple, rotation and broken flag."""
+    the law's columns, then the rolling couple, rotation and broken flag. With
+    ``ranged`` a law with a range acts across a gap below it."""
     R = ti.static(history_width(laws))
     xi = pos[i]
     ri = prop[i][PROP_RADIUS]
@@ -294,6 +295,9 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         d2 = 0.0
         if not shaped:
             d, d2 = disc_segment.overlap(xi, a, b, wall[w, W_INVLL])
+        cut = ri
+        if ti.static(ranged):
+            cut = ri + lawp[ti.cast(wall[w, W_LAW], ti.i32), COL_REACH]
         if shaped:       # (False, a constant, in a model without shapes)
             c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
             touching, f, mi, n, fn, fs, u, xc, vw, h, d1 = shaped_wall(
@@ -318,7 +322,7 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             elif wcs[i, s][2] > 0.0:
                 wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
                 wcs[i, s] = ti.Vector([0.0, 0.0, u])
-        elif d2 < ri * ri:
+        elif d2 < cut * cut:
             c = ti.Vector([wall[w, W_CX], wall[w, W_CY]])
             ww = wall[w, W_OMEGA]
             u, n, t, ai, xc, vw, vrel = disc_segment.kinematics(
@@ -330,13 +334,26 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             fn_el, fn, ft, kn, cnd, d1, h = law_force(
                 laws, lawp, L, u, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri, dt, h)
             fs_tot = ft[0]
-            m, m_tot, th, brk, d2r = rolling_couple(
-                lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[R], h[R + 1], h[R + 2])
+            m_tot = 0.0
+            d2r = 0.0
+            touching = 1
+            if ti.static(ranged):
+                touching = u > 0.0
+            if touching:
+                m, m_tot1, th, brk, d2r1 = rolling_couple(
+                    lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - ww, dt, h[R], h[R + 1],
+                    h[R + 2])
+                m_tot = m_tot1
+                d2r = d2r1
+                h[R] = m
+                h[R + 1] = th
+                h[R + 2] = brk
+            else:
+                h[R] = 0.0
+                h[R + 1] = 0.0
+                h[R + 2] = 0.0
             f = -fn * n + tangent_vector(ft, n)
             mi = ai * fs_tot + m_tot
-            h[R] = m
-            h[R + 1] = th
-            h[R + 2] = brk
             whist[i, s] = h
             wcn[i, s] = n
             wcf[i, s] = ti.Vector([f[0], f[1], mi, 0.0])
@@ -350,7 +367,8 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             ti.atomic_add(wpart[row, w][1], -f[1])
             ti.atomic_add(wpart[row, w][2], r[0] * (-f[1]) - r[1] * (-f[0]) - m_tot)
             ti.atomic_add(wpart[row, w][3], 1.0)
-        elif whist[i, s][0] != 0.0 or wcs[i, s][2] > 0.0 or whist[i, s][R] != 0.0:
+        elif (whist[i, s][0] != 0.0 or wcs[i, s][2] > 0.0 or whist[i, s][R] != 0.0
+              or (ranged and whist[i, s].dot(whist[i, s]) != 0.0)):
             whist[i, s] = zero_history(whist[i, s])
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0])
             wcs[i, s] = ti.Vector([0.0, 0.0, ri - ti.sqrt(d2)])
@@ -358,10 +376,11 @@ def wall_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
 
 
 @ti.func
-def _mesh_geometry(xi, ri, shaped, mat, abc, wall: ti.template(), w):
-    """(touching, depth, n from the particle to the wall, contact point, feature,
+def _mesh_geometry(xi, ri, shaped, mat, abc, wall: ti.template(), w, reach):
+    """(live, depth, n from the particle to the wall, contact point, feature,
     Hertz radius) of a sphere (radius ri) or an ellipsoid (``shaped``: shape matrix
-    ``mat``, semi-axes ``abc``) against mesh triangle w."""
+    ``mat``, semi-axes ``abc``) against mesh triangle w; live: the depth is above
+    −``reach`` (0, or the range of a law that acts across a gap)."""
     a = tri_vec(wall, w, T_AX)
     b = tri_vec(wall, w, T_BX)
     c = tri_vec(wall, w, T_CX)
@@ -381,7 +400,16 @@ def _mesh_geometry(xi, ri, shaped, mat, abc, wall: ti.template(), w):
         if dist > 0.0:
             n = d / dist
         point = xi + (ri - 0.5 * depth) * n
-    return depth > 0.0, depth, n, point, feat, radius
+    return depth > -reach, depth, n, point, feat, radius
+
+
+@ti.func
+def _wall_reach(wall: ti.template(), lawp: ti.template(), w, ranged: ti.template()):
+    """The range of mesh triangle w's law (0 unless ``ranged``)."""
+    r = 0.0
+    if ti.static(ranged):
+        r = lawp[ti.cast(wall[w, T_LAW], ti.i32), COL_REACH]
+    return r
 
 
 @ti.func
@@ -389,7 +417,7 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                   prop: ti.template(), wall: ti.template(), wpart: ti.template(), row,
                   lawp: ti.template(), wid: ti.template(), whist: ti.template(),
                   wcn: ti.template(), wcf: ti.template(), wcs: ti.template(), dt,
-                  laws: ti.template(), shaped, mat, abc):
+                  laws: ti.template(), shaped, mat, abc, ranged: ti.template()):
     """3D: contacts of particle i (a sphere, or an ellipsoid when ``shaped``: shape
     matrix ``mat``, semi-axes ``abc``) with its candidate mesh triangles (wall slots),
     by the nearest point of each triangle (:mod:`physics.geometry.sphere_triangle`,
@@ -400,7 +428,9 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
     moves to a neighbouring triangle of the same mesh takes its shear spring along.
     Returns (force, moment, dissipation, work of the walls) and adds what the walls
     receive to ``wpart`` as :func:`wall_contacts`.
-    An ellipsoid's wall history keeps its Hertz radius after the law's columns."""
+    An ellipsoid's wall history keeps its Hertz radius after the law's columns. With
+    ``ranged`` a law with a range acts across a gap below it (a face within range
+    counts as a face contact)."""
     T = ti.static(tangent_dim(3))
     RW = ti.static(history_width(laws, T))
     xi = pos[i]
@@ -419,7 +449,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         w = wid[i, s]
         if w < 0:
             break
-        touch, depth, n, point, feat, radius = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w)
+        touch, depth, n, point, feat, radius = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w,
+                                                              _wall_reach(wall, lawp, w, ranged))
         if touch and feat == sphere_triangle.FACE and nfaced < 4:
             faced[nfaced] = ti.cast(wall[w, T_MESH], ti.i32)
             nfaced += 1
@@ -427,7 +458,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
         w = wid[i, s]
         if w < 0:
             break
-        live, depth, n, point, feat, radius = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w)
+        live, depth, n, point, feat, radius = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w,
+                                                             _wall_reach(wall, lawp, w, ranged))
         mesh = ti.cast(wall[w, T_MESH], ti.i32)
         if live and feat != sphere_triangle.FACE:
             for k in ti.static(range(4)):
@@ -436,7 +468,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             for s2 in range(s):
                 w2 = wid[i, s2]
                 if ti.cast(wall[w2, T_MESH], ti.i32) == mesh:
-                    t2, u2, n2, p2, f2, r2 = _mesh_geometry(xi, ri, shaped, mat, abc, wall, w2)
+                    t2, u2, n2, p2, f2, r2 = _mesh_geometry(
+                        xi, ri, shaped, mat, abc, wall, w2, _wall_reach(wall, lawp, w2, ranged))
                     if t2 and f2 != sphere_triangle.FACE and (p2 - point).norm() <= 1e-9 * ri:
                         live = False
         h = whist[i, s]
@@ -448,8 +481,9 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                     if w2 >= 0 and s2 != s and ti.cast(wall[w2, T_MESH], ti.i32) == mesh:
                         h2 = whist[i, s2]
                         if get_first(h2, T) != 0.0:
-                            t2, u2, n2, p2, f2, r2 = _mesh_geometry(xi, ri, shaped, mat, abc,
-                                                                    wall, w2)
+                            t2, u2, n2, p2, f2, r2 = _mesh_geometry(
+                                xi, ri, shaped, mat, abc, wall, w2,
+                                _wall_reach(wall, lawp, w2, ranged))
                             if not (t2 and f2 == sphere_triangle.FACE):
                                 h = h2
                                 whist[i, s2] = zero_history(h2)
@@ -467,15 +501,23 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             mi = moment(arm, f)
             m_roll = ti.Vector([0.0, 0.0, 0.0])
             if ti.static(h.n >= RW + 7):
-                # rolling resistance against the wall (r̄ = 2 R_i, Jiang Eq. 11b)
-                m, m_roll, th, brk, d2 = rolling_couple_3d(
-                    lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - tri_vec(wall, w, T_WX), n, dt,
-                    get_columns(h, RW, 3), get_columns(h, RW + 3, 3), h[RW + 6])
-                h = put_columns(h, RW, m)
-                h = put_columns(h, RW + 3, th)
-                h[RW + 6] = brk
-                mi += m_roll
-                diss += d2
+                # rolling resistance against the wall (r̄ = 2 R_i, Jiang Eq. 11b), in contact
+                touching = 1
+                if ti.static(ranged):
+                    touching = depth > 0.0
+                if touching:
+                    m, m_roll1, th, brk, d2 = rolling_couple_3d(
+                        lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - tri_vec(wall, w, T_WX), n,
+                        dt, get_columns(h, RW, 3), get_columns(h, RW + 3, 3), h[RW + 6])
+                    m_roll = m_roll1
+                    h = put_columns(h, RW, m)
+                    h = put_columns(h, RW + 3, th)
+                    h[RW + 6] = brk
+                    mi += m_roll
+                    diss += d2
+                else:
+                    for c7 in ti.static(range(7)):
+                        h[RW + c7] = 0.0
             elif ti.static(h.n > RW):
                 h[RW] = radius
             whist[i, s] = h
@@ -491,7 +533,8 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
                 ti.atomic_add(wpart[row, w][k], -f[k])
                 ti.atomic_add(wpart[row, w][3 + k], tw[k])
             ti.atomic_add(wpart[row, w][6], 1.0)
-        elif get_first(h, T) != 0.0 or wcs[i, s][2] > 0.0:
+        elif (get_first(h, T) != 0.0 or wcs[i, s][2] > 0.0
+              or (ranged and h.dot(h) != 0.0)):
             whist[i, s] = zero_history(h)
             wcf[i, s] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
             wcs[i, s] = ti.Vector([0.0, 0.0, ti.min(depth, 0.0)])
@@ -742,7 +785,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             if ti.static(dim == 2):
                 fw, mw, dw, work = wall_contacts(i, pos, vel, omega, prop, wall, wpart, row,
                                                  lawp, wid, whist, wcn, wcf, wcs, dt, laws, angle,
-                                                 shp, flags, shapes)
+                                                 shp, flags, shapes, ranged)
             else:
                 if ti.static(shapes & SHAPES_POLY):
                     if ipoly:
@@ -752,7 +795,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                 if not ipoly:
                     fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wpart,
                                                      row, lawp, wid, whist, wcn, wcf, wcs, dt,
-                                                     laws, ishaped, mati, shi)
+                                                     laws, ishaped, mati, shi, ranged)
             own = pack(f + fw, tq + mw, dim)
             if ti.static(serial or chunk):
                 facc[i] = facc[i] + own
@@ -1219,9 +1262,9 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
             w = wid[i, s]
             if w >= 0:
                 u = wcs[i, s][2]
-                if u > 0.0:
+                L = ti.cast(wall[w, ti.static(W_LAW if dim == 2 else T_LAW)], ti.i32)
+                if u > 0.0 or u > -lawp[L, COL_REACH]:
                     h = whist[i, s]
-                    L = ti.cast(wall[w, ti.static(W_LAW if dim == 2 else T_LAW)], ti.i32)
                     reff = ri
                     if ti.static(dim == 2):
                         if h[WST] > 0.0:
@@ -1230,12 +1273,14 @@ def elastic_energy_sum(pos: ti.types.ndarray(), prop: ti.types.ndarray(),
                         if h[R] > 0.0:           # an ellipsoid's Hertz radius
                             reff = h[R]
                     total += law_energy(laws, lawp, L, u, reff, h, T)
-                    if ti.static(dim == 2):
-                        kn = law_stiffness(laws, lawp, L, u, reff)
-                        total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri)
-                    elif ti.static(h.n >= R + 7):
-                        kn = law_stiffness(laws, lawp, L, u, reff)
-                        total += rolling_energy_3d(lawp, L, kn, get_columns(h, R, 3), 2.0 * ri)
+                    if u > 0.0:
+                        if ti.static(dim == 2):
+                            kn = law_stiffness(laws, lawp, L, u, reff)
+                            total += rolling_energy(lawp, L, kn, h[R], 2.0 * ri)
+                        elif ti.static(h.n >= R + 7):
+                            kn = law_stiffness(laws, lawp, L, u, reff)
+                            total += rolling_energy_3d(lawp, L, kn, get_columns(h, R, 3),
+                                                       2.0 * ri)
     return total
 
 
@@ -1278,7 +1323,7 @@ def particle_stress(prop: ti.types.ndarray(), angle: ti.types.ndarray(),
                 s -= _arm(shaped, si, ci, sni, ri, -cn[j, k], u).outer_product(
                     ti.Vector([c[0], c[1]]))
         for q in range(wid.shape[1]):
-            if wid[i, q] >= 0 and wcs[i, q][2] > 0.0:
+            if wid[i, q] >= 0 and (wcs[i, q][2] > 0.0 or wcs[i, q][0] != 0.0):
                 u = wcs[i, q][2]
                 c = wcf[i, q]
                 s += _arm(shaped, si, ci, sni, ri, wcn[i, q], u).outer_product(

@@ -297,3 +297,41 @@ def test_bad_wet_input_is_named():
     law.update(volume=8e-12, friction=0.3)
     assert law.bridge.volume == 8e-12 and law.dry.friction == 0.3
     assert law.acting_range() == pytest.approx(2e-4)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_bridge_to_a_wall_holds_across_the_gap_to_its_rupture(dim):
+    """A sphere wetted by touching a floor (a segment wall in 2D, a mesh in 3D) of the
+    wet law, lifted at 0.02 m/s: the pull is Willett's for a sphere and a plane, R =
+    2R* = 2R_i (F₀ = 4πR_iγ cos θ; in 2D per metre of a layer 4R* = 4R_i thick), at
+    every gap to 1e-9, until the gap passes Lian's distance."""
+    law, lb = _wet()
+    sim = tdem.Simulation(gravity=(0.0,) * dim, progress=False, dt=1e-6, dim=dim,
+                          local_damping=0.0)
+    x = np.zeros((1, dim))
+    x[0, -1] = R - 1e-8
+    sim.add_particles(x, R, density=RHO, contact=law)
+    if dim == 2:
+        sim.add_wall((-0.01, 0.0), (0.01, 0.0), contact=law)
+        sim.fix_particles([0], vx=0.0, vy=0.02, omega=0.0)
+    else:
+        v, t = tdem.surfaces.plane((0.0, 0.0, 0.0), (0, 0, 1), 0.01)
+        sim.add_mesh(v, t, contact=law)
+        sim.fix_particles([0], vx=0.0, vy=0.0, vz=0.02, omega=(0.0, 0.0, 0.0))
+    v, dt, s_rup = 0.02, sim.dt, lb.rupture_distance
+    f0 = 4 * math.pi * R * 0.072 * math.cos(math.radians(20.0))
+    k = 0.5 * math.sqrt(2 * R / 2e-12)
+    per = 1.0 if dim == 3 else 1.0 / (4 * R)
+    seen = 0
+    for _ in range(7):
+        sim.run(steps=1000)
+        gap = sim.particles.numpy()["position"][0, -1] - R - v * dt       # at x_n
+        c = sim.contacts.numpy()
+        assert c["pairs"][0, 1] == -1
+        x_ = k * gap
+        assert c["normal"][0] == pytest.approx(-per * f0 / (1 + 2.1 * x_ + 10 * x_ * x_),
+                                               rel=1e-9)
+        seen += 1
+    sim.run(steps=int(s_rup / (v * dt)) - 7000 + 5)
+    assert len(sim.contacts.numpy()["pairs"]) == 0
+    assert np.abs(sim.particles.numpy()["force"]).max() == 0.0
