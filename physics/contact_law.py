@@ -90,7 +90,7 @@ _REGISTRY = []           # law classes; a class's code is its index
 _BY_NAME = {}
 # built-in laws registered when first made (their history columns would widen every
 # simulation's contacts): name → module
-_ON_FIRST_USE = {"WetContact": "physics.wet_contact"}
+_ON_FIRST_USE = {"WetContact": "physics.wet_contact", "Granular": "physics.granular"}
 
 
 def register_law(cls):

@@ -19,6 +19,8 @@ from physics.rolling import RollingResistance
 from physics.parallel_bond import ParallelBond
 from physics.liquid_bridge import LiquidBridge
 from physics.wet_contact import WetContact
+from physics import granular
+from physics.granular import Granular, register_submodel
 from physics.materials import JWL, Elastic, Fluid, MohrCoulomb
 from physics.polyhedron import Polyhedron
 from physics.shapes import Ellipsoid, Superellipse
@@ -43,4 +45,4 @@ __all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",
            "InstabilityError", "CapacityError", "mesh", "pack", "plot_history",
            "ensemble", "grading", "Grading", "motion", "TriaxialCell", "ParallelBond",
-           "LiquidBridge", "WetContact"]
+           "LiquidBridge", "WetContact", "Granular", "granular", "register_submodel"]
