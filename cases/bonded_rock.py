@@ -37,6 +37,7 @@ FVM models of ``uniaxial_compression`` (docs/cases.md), and the cracks' modes (P
 most in tension).
 """
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -55,6 +56,9 @@ RAMP = 1e-3               # s
 DAMPING = 0.7
 FRACTION = 0.80
 SIDE3D, HEIGHT3D, FRACTION3D = 0.05, 0.1, 0.55
+THICK3D = 0.05
+BAND = 0.25                # the central band: ±BAND·R about the loaded diameter
+UC_MODELS = ("random", "fvm")
 PRESETS = {"quick": {"rmin": 2e-3, "seed": 1}, "paper": {"rmin": 1e-3, "seed": 1}}
 
 
@@ -119,22 +123,60 @@ def load(sim, top, bottom, h, max_strain=4e-3, drop=0.6, every=100):
     return np.array(rows)
 
 
+def secant(strain, stress):
+    """(E, peak): the secant slope of stress against strain between 20 % and 50 % of
+    the peak, before it (the first and last points in that range), and the peak."""
+    strain, stress = np.asarray(strain, float), np.asarray(stress, float)
+    k = int(np.argmax(stress))
+    peak = float(stress[k])
+    sel = (stress[:k + 1] >= 0.2 * peak) & (stress[:k + 1] <= 0.5 * peak)
+    lo, hi = np.flatnonzero(sel)[[0, -1]] if sel.sum() >= 2 else (0, k)
+    e_mod = float((stress[hi] - stress[lo]) / (strain[hi] - strain[lo])) if hi > lo else \
+        float("nan")
+    return e_mod, peak
+
+
+def _tension(c):
+    return float(np.mean(c["mode"] == 0)) if len(c["mode"]) else None
+
+
 def uniaxial(cfg, opts, **scale):
     sim, top, bottom, h, made = specimen(cfg, "prism", opts, **scale)
     hist = load(sim, top, bottom, h)
     stress = hist[:, 1] / WIDTH
-    peak = float(stress.max())
-    k = int(np.argmax(stress))
-    sel = (stress[:k + 1] >= 0.2 * peak) & (stress[:k + 1] <= 0.5 * peak)
-    lo, hi = np.flatnonzero(sel)[[0, -1]] if sel.sum() >= 2 else (0, k)
-    e_mod = float((stress[hi] - stress[lo]) / (hist[hi, 0] - hist[lo, 0])) if hi > lo else \
-        float("nan")
+    e_mod, peak = secant(hist[:, 0], stress)
     c = sim.cracks.numpy()
     return {"ucs": peak, "E": e_mod, "strain": hist[:, 0], "stress": stress,
             "particles": sim.n_particles, "bonds": made, "cracks": len(c["time"]),
-            "tension_fraction": float(np.mean(c["mode"] == 0)) if len(c["mode"]) else None,
+            "tension_fraction": _tension(c),
             "crack_xy": c["position"], "crack_mode": c["mode"],
             "xy": sim.particles.numpy()["position"], "steps": sim.steps, "dt": sim.dt}
+
+
+def _spheres(cfg, opts, x, r, scale_modulus=1.0, scale_strength=1.0):
+    """A simulation of bonded spheres at (x, r): contacts k_n = E_c π R̄/2 (PFC3D's
+    E_c A/L, A = π R², L = 2R, at the mean radius), the bonds of :func:`laws` made
+    between spheres within 5 % of R_min. Returns (sim, contact law, bonds made)."""
+    rmin = 1.25 * cfg["rmin"]
+    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), local_damping=DAMPING,
+                          progress=False, **opts)
+    ec = E_ROCK * scale_modulus
+    kn = ec * math.pi * float(np.mean(r)) / 2.0
+    contact = tdem.LinearContact(kn=kn, ks=kn / KAPPA, friction=0.5)
+    _, bond = laws(scale_modulus, scale_strength)
+    g = sim.add_particles(x, r, density=RHO, contact=contact)
+    made = sim.bond(g, bond, gap=0.05 * rmin)
+    return sim, contact, made
+
+
+def _platens3d(sim, contact, centre, lo, hi, size):
+    """Two square mesh platens of side ``size`` at z = lo (facing up) and z = hi
+    (facing down), centred over ``centre`` (x, y). Returns (top, bottom)."""
+    v, t = tdem.surfaces.plane((centre[0], centre[1], lo), (0.0, 0.0, 1.0), size)
+    bottom = sim.add_mesh(v, t, contact=contact)
+    v2, t2 = tdem.surfaces.plane((centre[0], centre[1], hi), (0.0, 0.0, -1.0), size)
+    top = sim.add_mesh(v2, t2, contact=contact)
+    return top, bottom
 
 
 def specimen3d(cfg, opts, scale_modulus=1.0, scale_strength=1.0):
@@ -145,26 +187,16 @@ def specimen3d(cfg, opts, scale_modulus=1.0, scale_strength=1.0):
     x, r = tdem.pack.random3d((0.0, 0.0, 0.0), (SIDE3D, SIDE3D, HEIGHT3D), rmin,
                               1.66 * rmin, seed=cfg["seed"], target_fraction=FRACTION3D,
                               overlap_tol=5e-5)
-    sim = tdem.Simulation(dim=3, gravity=(0.0, 0.0, 0.0), local_damping=DAMPING,
-                          progress=False, **opts)
-    ec = E_ROCK * scale_modulus
-    # PFC3D's k_n = E_c A/L, A = π R², L = 2R, at the mean radius
-    kn = ec * math.pi * float(np.mean(r)) / 2.0
-    contact = tdem.LinearContact(kn=kn, ks=kn / KAPPA, friction=0.5)
-    _, bond = laws(scale_modulus, scale_strength)
-    g = sim.add_particles(x, r, density=RHO, contact=contact)
-    made = sim.bond(g, bond, gap=0.05 * rmin)
-    v, t = tdem.surfaces.plane((0.5 * SIDE3D, 0.5 * SIDE3D, 0.0), (0.0, 0.0, 1.0), 2 * SIDE3D)
-    bottom = sim.add_mesh(v, t, contact=contact)
-    v2, t2 = tdem.surfaces.plane((0.5 * SIDE3D, 0.5 * SIDE3D, HEIGHT3D), (0.0, 0.0, -1.0),
-                                 2 * SIDE3D)
-    top = sim.add_mesh(v2, t2, contact=contact)
+    sim, contact, made = _spheres(cfg, opts, x, r, scale_modulus, scale_strength)
+    top, bottom = _platens3d(sim, contact, (0.5 * SIDE3D, 0.5 * SIDE3D), 0.0, HEIGHT3D,
+                             2 * SIDE3D)
     return sim, top, bottom, HEIGHT3D, made
 
 
-def uniaxial3d(cfg, opts, **scale):
-    sim, top, bottom, h, made = specimen3d(cfg, opts, **scale)
-    rows, peak, every = [], 0.0, 100
+def load3d(sim, top, bottom, h, area, max_strain=4e-3, drop=0.6, every=100):
+    """:func:`load` for spheres between mesh platens (loaded along z): returns arrays
+    (strain, platen force / ``area``, cracks)."""
+    rows, peak = [], 0.0
     while True:
         v = _ramp(sim.time)
         top.velocity = (0.0, 0.0, -v)
@@ -172,23 +204,81 @@ def uniaxial3d(cfg, opts, **scale):
         sim.run(steps=every)
         f = 0.5 * (top.force[2] - bottom.force[2])
         strain = (rows[-1][0] if rows else 0.0) + 2 * v * every * sim.dt / h
-        rows.append((strain, f / SIDE3D ** 2, len(sim.cracks)))
+        rows.append((strain, f / area, len(sim.cracks)))
         peak = max(peak, rows[-1][1])
-        if strain >= 4e-3 or (peak > 0 and rows[-1][1] < 0.6 * peak
-                              and rows[-1][1] < rows[-2][1]):
+        if strain >= max_strain or (peak > 0 and rows[-1][1] < drop * peak
+                                    and rows[-1][1] < rows[-2][1]):
             break
-    hist = np.array(rows)
+    return np.array(rows)
+
+
+def uniaxial3d(cfg, opts, **scale):
+    sim, top, bottom, h, made = specimen3d(cfg, opts, **scale)
+    hist = load3d(sim, top, bottom, h, SIDE3D ** 2)
     stress = hist[:, 1]
-    k = int(np.argmax(stress))
-    sel = (stress[:k + 1] >= 0.2 * stress[k]) & (stress[:k + 1] <= 0.5 * stress[k])
-    lo, hi = np.flatnonzero(sel)[[0, -1]] if sel.sum() >= 2 else (0, k)
+    e_mod, peak = secant(hist[:, 0], stress)
     c = sim.cracks.numpy()
-    return {"ucs": float(stress[k]),
-            "E": float((stress[hi] - stress[lo]) / (hist[hi, 0] - hist[lo, 0])),
-            "strain": hist[:, 0], "stress": stress, "particles": sim.n_particles,
-            "bonds": made, "cracks": len(c["time"]),
-            "tension_fraction": float(np.mean(c["mode"] == 0)) if len(c["mode"]) else None,
-            "steps": sim.steps, "dt": sim.dt}
+    return {"ucs": peak, "E": e_mod, "strain": hist[:, 0], "stress": stress,
+            "particles": sim.n_particles, "bonds": made, "cracks": len(c["time"]),
+            "tension_fraction": _tension(c), "steps": sim.steps, "dt": sim.dt}
+
+
+def specimen3d_disc(cfg, opts):
+    """Bonded spheres: a disc of diameter 0.1 m and thickness THICK3D (axis along y)
+    cut from a random packing of its bounding box: the spheres whose centre lies within
+    D/2 − r/2 of the axis (the rim as rough as half a sphere either side of the nominal
+    diameter); at the top and bottom the spheres the packing pressed flat against the
+    box's faces form two flat seats, on which two square mesh platens rest. Returns
+    (sim, top, bottom, height, bonds made, seat half-width)."""
+    rmin = 1.25 * cfg["rmin"]
+    x, r = tdem.pack.random3d((0.0, 0.0, 0.0), (DIAM, THICK3D, DIAM), rmin, 1.66 * rmin,
+                              seed=cfg["seed"], target_fraction=FRACTION3D,
+                              overlap_tol=5e-5)
+    keep = np.hypot(x[:, 0] - 0.5 * DIAM, x[:, 2] - 0.5 * DIAM) <= 0.5 * DIAM - 0.5 * r
+    x, r = x[keep], r[keep]
+    sim, contact, made = _spheres(cfg, opts, x, r)
+    lo, hi = float((x[:, 2] - r).min()), float((x[:, 2] + r).max())
+    top, bottom = _platens3d(sim, contact, (0.5 * DIAM, 0.5 * THICK3D), lo, hi, 1.5 * DIAM)
+    # the seats: the spheres touching a platen at the start (within 1 % of R_min)
+    seated = (x[:, 2] + r >= hi - 0.01 * rmin) | (x[:, 2] - r <= lo + 0.01 * rmin)
+    seat = float(np.abs(x[seated, 0] - 0.5 * DIAM).max())
+    return sim, top, bottom, hi - lo, made, seat
+
+
+def band_share(a):
+    """The share of a disc's area within ±a·R of a diameter: where cracks spread evenly
+    over the disc would lie."""
+    return 2.0 * (a * math.sqrt(1.0 - a * a) + math.asin(a)) / math.pi
+
+
+def in_band(xy, centre, half_width):
+    """The share of the points ``xy`` (the cracks) within ``half_width`` of the loaded
+    diameter x = ``centre`` (None: no cracks)."""
+    return float(np.mean(np.abs(xy[:, 0] - centre) <= half_width)) if len(xy) else None
+
+
+def hondros(alpha):
+    """Hondros' tensile stress at the centre of a disc loaded over two arcs 2α (radial
+    pressure), over 2P/(πDt) of a line load: (sin 2α − α)/sin α."""
+    return (math.sin(2 * alpha) - alpha) / math.sin(alpha) if alpha > 0 else 1.0
+
+
+def brazilian3d(cfg, opts):
+    sim, top, bottom, h, made, seat = specimen3d_disc(cfg, opts)
+    hist = load3d(sim, top, bottom, h, 1.0, max_strain=2e-2)
+    p = float(hist[:, 1].max())
+    c = sim.cracks.numpy()
+    alpha = math.asin(min(1.0, seat / (0.5 * DIAM)))
+    return {"sigma_t": 2 * p / (math.pi * DIAM * THICK3D), "P_max": p,
+            "thickness": THICK3D, "strain": hist[:, 0],
+            "nominal": 2 * hist[:, 1] / (math.pi * DIAM * THICK3D),
+            "particles": sim.n_particles, "bonds": made, "cracks": len(c["time"]),
+            "crack_xy": c["position"][:, [0, 2]], "crack_mode": c["mode"],
+            "xy": sim.particles.numpy()["position"][:, [0, 2]],
+            "tension_fraction": _tension(c),
+            "central_band": in_band(c["position"], 0.5 * DIAM, BAND * 0.5 * DIAM),
+            "seat_half_width": seat, "seat_angle_deg": math.degrees(2 * alpha),
+            "hondros_factor": hondros(alpha), "steps": sim.steps, "dt": sim.dt}
 
 
 def brazilian(cfg, opts):
@@ -197,13 +287,52 @@ def brazilian(cfg, opts):
     p = float(hist[:, 1].max())
     c = sim.cracks.numpy()
     return {"sigma_t": 2 * p / (math.pi * DIAM), "P_max": p, "strain": hist[:, 0],
-            "force": hist[:, 1], "particles": sim.n_particles, "bonds": made,
-            "cracks": len(c["time"]), "crack_xy": c["position"], "crack_mode": c["mode"],
-            "xy": sim.particles.numpy()["position"],
-            "tension_fraction": float(np.mean(c["mode"] == 0)) if len(c["mode"]) else None}
+            "nominal": 2 * hist[:, 1] / (math.pi * DIAM), "particles": sim.n_particles,
+            "bonds": made, "cracks": len(c["time"]), "crack_xy": c["position"],
+            "crack_mode": c["mode"], "xy": sim.particles.numpy()["position"],
+            "tension_fraction": _tension(c),
+            "central_band": in_band(c["position"], 0.5 * DIAM, BAND * 0.5 * DIAM),
+            "steps": sim.steps, "dt": sim.dt}
 
 
-def plots(base, stiff, strong, braz, out, sph=None, sph2=None):
+def continuum_curves(preset, out, opts, source=None):
+    """The stress–strain curves of ``uniaxial_compression``'s models UC_MODELS (the same
+    rock as Mohr–Coulomb continua): read from ``source``/histories.h5 (a folder that
+    case wrote) if given, else made by running that case's ``run`` for those models at
+    ``preset`` into out/uniaxial_compression. Returns ({name: {strain, stress, label,
+    E, ucs, elastic_slope}}, where they came from)."""
+    import json
+
+    import h5py
+
+    from . import _pcmm
+    from . import uniaxial_compression as uc
+    if source is None:
+        folder = out / uc.CASE
+        uc.run(preset, folder, models=list(UC_MODELS), arch=opts.get("arch"),
+               threads=opts.get("threads"))
+        origin = {"ran": f"cases.uniaxial_compression, preset {preset}",
+                  "folder": str(folder)}
+    else:
+        folder = Path(source)
+        meta = folder / "summary.json"
+        ran = json.loads(meta.read_text()).get("preset") if meta.exists() else None
+        origin = {"read": str(folder / "histories.h5"), "preset": ran}
+    curves = {}
+    with h5py.File(folder / "histories.h5", "r") as f:
+        for name in UC_MODELS:
+            if name not in f:
+                print(f"  {name}: not in {folder / 'histories.h5'}", flush=True)
+                continue
+            strain, stress = np.asarray(f[name]["strain"]), np.asarray(f[name]["stress"])
+            e_mod, peak = secant(strain, stress)
+            curves[name] = {"strain": strain, "stress": stress, "label": _pcmm.LABELS[name],
+                            "E": e_mod, "ucs": peak,
+                            "elastic_slope": uc.elastic_slope(strain, stress)}
+    return curves, origin
+
+
+def plots(base, stiff, strong, braz, out, sph=None, sph2=None, braz3=None, curves=None):
     plt = common.pyplot()
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4))
     for r, lab in ((base, "Ē = E_c = 30 GPa, σ̄_c = T, c̄ = c"), (stiff, "moduli × 2"),
@@ -225,17 +354,25 @@ def plots(base, stiff, strong, braz, out, sph=None, sph2=None):
     ax.set_title("Uniaxial compression of bonded discs and spheres", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
-    bx.plot(1e3 * braz["strain"], braz["force"] / 1e3)
+    bx.plot(1e3 * braz["strain"], braz["nominal"] / 1e6,
+            label=f"discs: σ_t = {braz['sigma_t'] / 1e6:.2f} MPa")
+    if braz3 is not None:
+        bx.plot(1e3 * braz3["strain"], braz3["nominal"] / 1e6, ls="-.",
+                label=f"spheres (t = {braz3['thickness']:g} m): σ_t = "
+                      f"{braz3['sigma_t'] / 1e6:.2f} MPa")
     bx.set_xlabel("platen closure / diameter (‰)")
-    bx.set_ylabel("platen force (kN per metre)")
-    bx.set_title(f"Brazilian test: σ_t = 2P/(πD) = {braz['sigma_t'] / 1e6:.2f} MPa "
-                 f"(rock T = 1 MPa)", fontsize=10)
+    bx.set_ylabel("2P/(πDt) (MPa)")
+    bx.set_title("Brazilian tests, D = 0.1 m (rock T = 1 MPa)", fontsize=10)
     bx.grid(alpha=0.3)
+    bx.legend(fontsize=7)
     fig.tight_layout()
     common.save(fig, out / "stress_strain.png")
 
-    fig, axes = plt.subplots(1, 2, figsize=(8, 5), gridspec_kw={"width_ratios": [1, 1]})
-    for a, r, title in ((axes[0], base, "uniaxial"), (axes[1], braz, "Brazilian")):
+    panels = [(base, "uniaxial, discs"), (braz, "Brazilian, discs")]
+    if braz3 is not None:
+        panels.append((braz3, "Brazilian, spheres (x–z)"))
+    fig, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 5))
+    for a, (r, title) in zip(axes, panels):
         a.scatter(r["xy"][:, 0], r["xy"][:, 1], s=1, color="0.8")
         xy, mode = r["crack_xy"], r["crack_mode"]
         if len(xy):
@@ -247,9 +384,53 @@ def plots(base, stiff, strong, braz, out, sph=None, sph2=None):
     fig.tight_layout()
     common.save(fig, out / "cracks.png")
 
+    if curves:
+        models_plot(base, sph, curves, out / "models_stress_strain.png")
+
+
+def models_plot(discs, spheres, curves, png):
+    """Axial stress against axial strain of the rock as Mohr–Coulomb continua (PCMM,
+    FVM) and as bonded discs and spheres, on one scale (left) and the bonded
+    particles' range enlarged (right)."""
+    plt = common.pyplot()
+    lines = [(c["strain"], c["stress"], c["label"], "-", 1.6) for c in curves.values()]
+    lines += [(discs["strain"], discs["stress"], "bonded discs", "-", 1.3)]
+    if spheres is not None:
+        lines += [(spheres["strain"], spheres["stress"], "bonded spheres", "-.", 1.3)]
+    colors = ["C2", "C3", "C0", "C1"]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.3))
+    for ax in axes:
+        for (e, s, lab, ls, lw), col in zip(lines, colors):
+            ax.plot(1e3 * e, s / 1e6, ls=ls, lw=lw, color=col, label=lab)
+        ax.axhline(UCS_MC / 1e6, color="k", ls="--", lw=1,
+                   label=f"Mohr–Coulomb UCS 2c cosφ/(1−sinφ) = {UCS_MC / 1e6:.2f} MPa")
+        ax.set_xlabel("axial strain (‰)")
+        ax.set_ylabel("axial stress (MPa, compression +)")
+        ax.grid(alpha=0.3)
+    bonded = [discs] + ([spheres] if spheres is not None else [])
+    right = max(float(r["strain"][-1]) for r in bonded)
+    top = max(float(r["stress"].max()) for r in bonded)
+    axes[0].set_xlim(left=0)
+    axes[0].set_ylim(0, 1.15 * max(UCS_MC, max(float(c["stress"].max())
+                                                  for c in curves.values())) / 1e6)
+    axes[0].set_title("The rock of Feng et al. 2015 §3.2: continua and bonded particles",
+                      fontsize=10)
+    axes[0].legend(fontsize=8, loc="center right")
+    axes[1].set_xlim(0, 1e3 * right)
+    axes[1].set_ylim(0, 1.3 * top / 1e6)
+    axes[1].set_title("the bonded particles' range enlarged", fontsize=10)
+    fig.tight_layout()
+    common.save(fig, png)
+
 
 def main(argv=None):
-    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0])
+    def extra(p):
+        p.add_argument("--curves", default=None, metavar="DIR",
+                       help="a folder uniaxial_compression wrote (its histories.h5): the "
+                            "PCMM and FVM curves to plot beside the bonded particles' "
+                            "(default: run those two models here, into OUT/"
+                            "uniaxial_compression)")
+    args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=extra)
     clock = common.Stopwatch()
     cfg = PRESETS[args.preset]
     opts = common.sim_options(args)
@@ -265,8 +446,14 @@ def main(argv=None):
     sph = uniaxial3d(cfg, opts)
     print("uniaxial, bonded spheres, strengths × 2", flush=True)
     sph2 = uniaxial3d(cfg, opts, scale_strength=2.0)
-    plots(base, stiff, strong, braz, out, sph, sph2)
+    print("Brazilian, bonded spheres", flush=True)
+    braz3 = brazilian3d(cfg, opts)
+    print("the continua of uniaxial_compression (PCMM, FVM)", flush=True)
+    curves, origin = continuum_curves(args.preset, out, opts, args.curves)
+    plots(base, stiff, strong, braz, out, sph, sph2, braz3, curves)
     ratio = braz["sigma_t"] / base["ucs"]
+    ratio3 = braz3["sigma_t"] / sph["ucs"]
+    share = band_share(BAND)
     checks = [
         common.check("trend.modulus", stiff["E"] / base["E"], 2.0, common.rel(0.05), "",
                      "E with Ē and E_c doubled over E (P&C: E ∝ the moduli)"),
@@ -277,6 +464,15 @@ def main(argv=None):
                      common.between(min=TENS / UCS_MC), "",
                      "σ_t (Brazilian) / UCS beside the rock's T/UCS = 0.078: the parallel "
                      "bond overestimates it (P&C: about 0.25)"),
+        common.check("brazilian.tension_cracks", braz["tension_fraction"], None,
+                     common.between(min=0.5), "",
+                     "Brazilian disc: share of the cracks in tension (P&C: most; the disc "
+                     "splits in tension)"),
+        common.check("brazilian.central_band", braz["central_band"], None,
+                     common.between(min=0.5), "",
+                     f"Brazilian disc: share of the cracks within ±D/8 of the loaded "
+                     f"diameter (the splitting along it): most, where cracks spread evenly "
+                     f"would put {share:.3f} there"),
         common.check("uniaxial.E", base["E"], E_ROCK / (1 - NU ** 2), None, "Pa",
                      "secant 20–50 % of the peak, beside the rock's E/(1 − ν²)"),
         common.check("uniaxial.UCS", base["ucs"], UCS_MC, None, "Pa",
@@ -290,28 +486,61 @@ def main(argv=None):
         common.check("spheres.trend.strength", sph2["ucs"] / sph["ucs"], 2.0,
                      common.rel(0.15), "", "bonded spheres: UCS with the strengths doubled "
                      "over UCS"),
+        common.check("spheres.tension_over_compression", ratio3, TENS / UCS_MC,
+                     common.between(min=TENS / UCS_MC), "",
+                     "bonded spheres: σ_t (Brazilian, 2 P_max/(π D t)) / UCS beside the "
+                     "rock's T/UCS = 0.078 (P&C: the parallel bond overestimates it)"),
+        common.check("spheres.brazilian.tension_cracks", braz3["tension_fraction"], None,
+                     common.between(min=0.5), "",
+                     "bonded spheres, Brazilian: share of the cracks in tension (P&C: most)"),
+        common.check("spheres.brazilian.central_band", braz3["central_band"], None,
+                     common.between(min=0.5), "",
+                     f"bonded spheres, Brazilian: share of the cracks within ±D/8 of the "
+                     f"loaded diameter: most, where cracks spread evenly would put "
+                     f"{share:.3f} there"),
         common.check("spheres.E", sph["E"], E_ROCK, None, "Pa",
                      "bonded spheres: secant 20–50 % of the peak, beside the rock's E"),
         common.check("spheres.UCS", sph["ucs"], UCS_MC, None, "Pa",
                      "bonded spheres: the peak beside the rock's strength"),
+        common.check("spheres.brazilian.sigma_t", braz3["sigma_t"], TENS, None, "Pa",
+                     "bonded spheres: 2 P_max/(π D t) beside the rock's T"),
     ]
     checks.append(common.check(
         "calibration.strength_factor", UCS_MC / base["ucs"], None, None, "",
         "the factor on σ̄_c and c̄ that gives the rock's UCS (UCS ∝ the strengths, "
         "trend.strength); its σ_t would then be this × the Brazilian's"))
     keep = ("ucs", "E", "particles", "bonds", "cracks", "tension_fraction", "steps", "dt")
+    models = {name: {"E": c["E"], "ucs": c["ucs"], "elastic_slope": c["elastic_slope"],
+                     "label": c["label"]} for name, c in curves.items()}
+    models["bonded_discs"] = {"E": base["E"], "ucs": base["ucs"], "label": "bonded discs"}
+    models["bonded_spheres"] = {"E": sph["E"], "ucs": sph["ucs"], "label": "bonded spheres"}
     data = {"preset": cfg, "rock": {"E": E_ROCK, "nu": NU, "c": COH, "T": TENS, "phi": PHI,
-                                     "ucs_mohr_coulomb": UCS_MC},
+                                     "ucs_mohr_coulomb": UCS_MC,
+                                     "plane_strain_modulus": E_ROCK / (1 - NU ** 2)},
+            "models": models,
+            "models_note": "E: secant 20–50 % of the peak for all; ucs: the peak; "
+                           "elastic_slope: uniaxial_compression's own (least squares, "
+                           "strain 0.1e-3 to 0.3e-3)",
+            "continua": origin,
             "uniaxial": {k: base[k] for k in keep},
             "moduli_x2": {k: stiff[k] for k in keep},
             "strengths_x2": {k: strong[k] for k in keep},
             "brazilian": {k: braz[k] for k in ("sigma_t", "P_max", "particles", "bonds",
-                                                "cracks", "tension_fraction")},
+                                                "cracks", "tension_fraction",
+                                                "central_band", "steps", "dt")},
             "spheres": {k: sph[k] for k in keep},
-            "spheres_strengths_x2": {k: sph2[k] for k in keep}}
+            "spheres_strengths_x2": {k: sph2[k] for k in keep},
+            "spheres_brazilian": {k: braz3[k] for k in (
+                "sigma_t", "P_max", "thickness", "particles", "bonds", "cracks",
+                "tension_fraction", "central_band", "seat_half_width", "seat_angle_deg",
+                "hondros_factor", "steps", "dt")},
+            "central_band_even_share": share}
     summary = common.summary(CASE, args.preset, checks, data, clock(), threads=args.threads,
                              paper=PAPER)
     common.write_summary(out, summary)
+    print("model: E (GPa), UCS (MPa)")
+    for m in models.values():
+        print(f"  {m['label']}: {m['E'] / 1e9:.1f}, {m['ucs'] / 1e6:.2f}")
     common.print_checks(summary)
     return summary
 
