@@ -1,4 +1,4 @@
-"""The rock of uniaxial_compression as parallel-bonded discs and spheres: uniaxial compression, a Brazilian test and the bonded-particle model's trends (Potyondy & Cundall 2004).
+"""The rock of uniaxial_compression as parallel-bonded discs and spheres: uniaxial compression, Brazilian tests and the bonded-particle model's trends (Potyondy & Cundall 2004).
 
 The rock of Feng, Li & Oñate (2015) §3.2 (``cases.uniaxial_compression``: E = 30 GPa,
 ν = 0.25, c = 3 MPa, T = 1 MPa, φ = 40°, ρ = 2500 kg/m³; its Mohr–Coulomb uniaxial
@@ -28,13 +28,50 @@ uncalibrated start a PFC user makes)
   that, ``tdem.pack.random3d`` at 0.55 with overlaps below 5e-5 R_min), the same bonds,
   contacts k_n = E_c π R̄/2 (PFC3D's E_c A/L, A = πR², L = 2R, at the mean radius),
   between two square mesh platens: uniaxial compression and its strength trend.
+- Brazilian test of bonded spheres: a disc of D = 0.1 m and thickness t = 0.05 m
+  (t/D = 0.5, the ISRM's proportion; 1311 spheres at the quick preset, the radii and
+  bonds of the prism), cut from a ``random3d`` packing of its bounding box (0.55):
+  the spheres whose centre lies within D/2 − r/2 of the axis, so that the rim is as
+  rough as half a sphere either side of the nominal diameter. At the top and bottom
+  the spheres that the packing pressed flat against the box's faces form two flat
+  seats, and two square mesh platens rest on them, closing as in the 2D test; σ_t =
+  2 P_max/(π D t). (Keeping only the spheres wholly inside the cylinder leaves one
+  sphere on top: its bonds broke at 1 % of the load and the platen then closed on
+  nothing for millimetres.) The seats span 2α ≈ 30° at the quick preset
+  (``seat_angle_deg``); Hondros' solution for a load spread over such arcs puts the
+  centre's tension at (sin 2α − α)/sin α ≈ 0.92 × 2P/(πDt) (``hondros_factor``,
+  reported, not applied: the 2D disc rests on single discs and uses the line-load
+  formula, and so does this one).
+- The splitting: the share of the Brazilian cracks (discs and spheres) within ±D/8 of
+  the loaded diameter, against the share of the disc's area in that band, 0.315,
+  where evenly spread cracks would lie; the check: most (above 0.5) lie there, and most
+  are tension cracks.
+- The continua: the stress–strain curves of the same rock as Mohr–Coulomb continua,
+  ``uniaxial_compression``'s PCMM random model and FVM regular mesh (UC_MODELS: a
+  random packing as the bonded particles', and the mesh), are made by running that
+  case's own ``run`` for those two models at the same preset into
+  OUT/uniaxial_compression (its summary.json, histories.h5 and plots, as that case
+  writes them; about 30 s at the quick preset), so that the curves are that case's
+  and no copy of its set-up lives here; ``--curves DIR`` reads them instead from the
+  histories.h5 of a folder that case wrote (any preset, e.g. docs/validation's). They
+  are loaded by a top plate at 0.1 m/s with the bottom fixed (strain rate 0.5/s,
+  10 × the bonded samples', and their curves keep the steps of the stress waves); E
+  of each as its case measures it (continua: least squares over strain 0.1e-3 to
+  0.3e-3; bonded: the secant above, their peaks coming before 0.1e-3), UCS the peak.
+  ``models_stress_strain.png``: axial stress against axial strain of the four, the
+  Mohr–Coulomb UCS dashed; on the right the bonded particles' range enlarged.
 
-What is compared: the trends (within 5 % and 15 %), the ratio σ_t/σ_c beside the
-rock's T/UCS = 0.078 (P&C: the parallel bond overestimates it, ≈ 0.25 for their
-granite model against ≈ 0.05–0.1 for rock; the check: above the rock's), E and UCS
-reported beside the rock's E/(1 − ν²) = 32 GPa and 12.87 MPa and beside the PCMM and
-FVM models of ``uniaxial_compression`` (docs/cases.md), and the cracks' modes (P&C:
+What is compared: the trends (within 5 % and 15 %), the ratio σ_t/σ_c of discs and
+of spheres beside the rock's T/UCS = 0.078 (P&C: the parallel bond overestimates it,
+≈ 0.25 for their granite model against ≈ 0.05–0.1 for rock; the check: above the
+rock's), the Brazilian splitting (above), E and UCS reported beside the rock's
+E/(1 − ν²) = 32 GPa and 12.87 MPa and beside the PCMM and FVM models of
+``uniaxial_compression`` (summary.json ``data.models``), and the cracks' modes (P&C:
 most in tension).
+
+Outputs (``--out DIR``, default out/bonded_rock): ``summary.json``,
+``stress_strain.png`` (the bonded samples, the Brazilian tests), ``cracks.png``,
+``models_stress_strain.png`` and the folder uniaxial_compression (above).
 """
 import math
 from pathlib import Path
@@ -311,8 +348,8 @@ def continuum_curves(preset, out, opts, source=None):
         folder = out / uc.CASE
         uc.run(preset, folder, models=list(UC_MODELS), arch=opts.get("arch"),
                threads=opts.get("threads"))
-        origin = {"ran": f"cases.uniaxial_compression, preset {preset}",
-                  "folder": str(folder)}
+        origin = {"ran": f"cases.uniaxial_compression, preset {preset}, models "
+                         f"{', '.join(UC_MODELS)}", "folder": uc.CASE}
     else:
         folder = Path(source)
         meta = folder / "summary.json"
@@ -510,17 +547,22 @@ def main(argv=None):
         "the factor on σ̄_c and c̄ that gives the rock's UCS (UCS ∝ the strengths, "
         "trend.strength); its σ_t would then be this × the Brazilian's"))
     keep = ("ucs", "E", "particles", "bonds", "cracks", "tension_fraction", "steps", "dt")
-    models = {name: {"E": c["E"], "ucs": c["ucs"], "elastic_slope": c["elastic_slope"],
-                     "label": c["label"]} for name, c in curves.items()}
-    models["bonded_discs"] = {"E": base["E"], "ucs": base["ucs"], "label": "bonded discs"}
-    models["bonded_spheres"] = {"E": sph["E"], "ucs": sph["ucs"], "label": "bonded spheres"}
+    secant_note = "secant 20–50 % of the peak"
+    models = {name: {"label": c["label"], "E": c["elastic_slope"], "ucs": c["ucs"],
+                     "E_measure": "uniaxial_compression's: least squares, strain 0.1e-3 to "
+                                  "0.3e-3", "E_secant_20_50": c["E"]}
+              for name, c in curves.items()}
+    models["bonded_discs"] = {"label": "bonded discs", "E": base["E"], "ucs": base["ucs"],
+                              "E_measure": secant_note}
+    models["bonded_spheres"] = {"label": "bonded spheres", "E": sph["E"], "ucs": sph["ucs"],
+                                "E_measure": secant_note}
     data = {"preset": cfg, "rock": {"E": E_ROCK, "nu": NU, "c": COH, "T": TENS, "phi": PHI,
                                      "ucs_mohr_coulomb": UCS_MC,
                                      "plane_strain_modulus": E_ROCK / (1 - NU ** 2)},
             "models": models,
-            "models_note": "E: secant 20–50 % of the peak for all; ucs: the peak; "
-                           "elastic_slope: uniaxial_compression's own (least squares, "
-                           "strain 0.1e-3 to 0.3e-3)",
+            "models_note": "the rock as Mohr–Coulomb continua (uniaxial_compression) and "
+                           "as bonded particles: E each as its case measures it "
+                           "(E_measure), ucs the peak stress",
             "continua": origin,
             "uniaxial": {k: base[k] for k in keep},
             "moduli_x2": {k: stiff[k] for k in keep},
