@@ -430,10 +430,15 @@ def models_plot(discs, spheres, curves, png):
     FVM) and as bonded discs and spheres, on one scale (left) and the bonded
     particles' range enlarged (right)."""
     plt = common.pyplot()
-    lines = [(c["strain"], c["stress"], c["label"], "-", 1.6) for c in curves.values()]
-    lines += [(discs["strain"], discs["stress"], "bonded discs", "-", 1.3)]
+    def label(name, e_mod, ucs):
+        return f"{name}: E {e_mod / 1e9:.1f} GPa, UCS {ucs / 1e6:.2f} MPa"
+    lines = [(c["strain"], c["stress"], label(c["label"], c["elastic_slope"], c["ucs"]),
+              "-", 1.6) for c in curves.values()]
+    lines += [(discs["strain"], discs["stress"],
+               label("bonded discs", discs["E"], discs["ucs"]), "-", 1.3)]
     if spheres is not None:
-        lines += [(spheres["strain"], spheres["stress"], "bonded spheres", "-.", 1.3)]
+        lines += [(spheres["strain"], spheres["stress"],
+                   label("bonded spheres", spheres["E"], spheres["ucs"]), "-.", 1.3)]
     colors = ["C2", "C3", "C0", "C1"]
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.3))
     for ax in axes:
@@ -452,7 +457,7 @@ def models_plot(discs, spheres, curves, png):
                                                   for c in curves.values())) / 1e6)
     axes[0].set_title("The rock of Feng et al. 2015 §3.2: continua and bonded particles",
                       fontsize=10)
-    axes[0].legend(fontsize=8, loc="center right")
+    axes[0].legend(fontsize=8, loc="lower right")
     axes[1].set_xlim(0, 1e3 * right)
     axes[1].set_ylim(0, 1.3 * top / 1e6)
     axes[1].set_title("the bonded particles' range enlarged", fontsize=10)
