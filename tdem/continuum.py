@@ -114,6 +114,10 @@ class Continuum:
         self.n = len(rad)
         self.slots = slots
         self.blocks = blocks
+        self._crit_driven = math.inf   # the driven nodes' critical step (when they move)
+        self._tol = None               # the Eq. 1 cut-offs uploaded last
+        self._load_fn = False          # loads or fixes given as functions of time
+        self._fix_fn = False
         self.has_pcmm = bool((pmat >= 0).any())
         self.walls = np.zeros((0, 4)) if walls is None else np.asarray(walls, float)[:, :4]
         # the Fluid bodies of Voronoi cells (physics.pcmm.cells): their slot per particle
@@ -371,7 +375,7 @@ class Continuum:
                 # whatever its stiffness: it does not limit the step (unless nothing does)
                 self._crit = min(self._crit, step)
             else:
-                self._crit_driven = min(getattr(self, "_crit_driven", math.inf), step)
+                self._crit_driven = min(self._crit_driven, step)
             off += len(b.vertices)
         self.nv = off
         nv, nt = max(off, 1), max(sum(len(t) for t in tris), 1)
@@ -577,7 +581,7 @@ class Continuum:
             tol[s] = 0.0 if t is None else t
         self.a["matp"].from_numpy(rows)
         self.a["mtol"].from_numpy(tol)
-        if not np.array_equal(tol, getattr(self, "_tol", tol)):
+        if self._tol is not None and not np.array_equal(tol, self._tol):
             self._full = True        # the Eq. 1 cut-offs changed: rebuild every element
         self._tol = tol
 
@@ -638,7 +642,7 @@ class Continuum:
         """Shortest element altitude / c_p over the initial PCMM elements and the
         block triangles (the Courant step of the element model)."""
         if math.isinf(self._crit):
-            return getattr(self, "_crit_driven", math.inf)
+            return self._crit_driven
         return self._crit
 
     # ---------------------------------------------------- the stages of one step
@@ -647,7 +651,7 @@ class Continuum:
         """Stage: node velocities and loads given by functions of time, uploaded."""
         if self._fix_fn_nodes():
             self.apply_node_fixes(sim._time)
-        if self.nv and getattr(self, "_load_fn", False):
+        if self.nv and self._load_fn:
             self.apply_node_loads(sim._time)
 
     def pcmm_elements(self, sim, dt, reach):
@@ -801,7 +805,7 @@ class Continuum:
         return self.has_pcmm or self.nq["p"] > 0 or getattr(self, "nr", {}).get("p", 0) > 0
 
     def _fix_fn_nodes(self):
-        return self.nv and getattr(self, "_fix_fn", False)
+        return self.nv and self._fix_fn
 
     def integrate(self, sim):
         """Stage: block nodes and rigid blocks move (tdem.nodes)."""

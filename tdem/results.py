@@ -153,7 +153,7 @@ class Results:
                 R3 = _claw.history_width(self._law_set, 3)
                 extra["moment"] = np.concatenate([hist[ii, kk, R3:R3 + 3],
                                                   whist[wi, wk, R3:R3 + 3]])
-            if getattr(self, "_polys", None):
+            if self._polys:
                 # polyhedra: the contact point is the overlap's centroid (a pair keeps
                 # it from the owner in its history; against a triangle the point on the
                 # triangle's plane below the centre), the overlap volume V = u l_c²
@@ -222,7 +222,7 @@ class Results:
     def _image(self, d):
         """Offsets ``d`` (…, 2) to their nearest periodic image."""
         d = np.array(d, dtype=float)
-        for k, span in enumerate(getattr(self, "_periodic", (None, None))):
+        for k, span in enumerate(self._periodic):
             if span is not None:
                 length = span[1] - span[0]
                 d[..., k] -= length * np.round(d[..., k] / length)
@@ -349,7 +349,7 @@ class Results:
                            "W_damping", "W_constraints", "W_applied", "Wp_damping",
                            "Wp_constraints",
                            "ke_half", "ke_start", "P_half"), 0.0)
-        dt = self._dt_run if getattr(self, "_dt_run", None) else 0.0
+        dt = self._dt_run if self._dt_run else 0.0
         a = self._a
         if self._n:
             eacc = a["eacc"].to_numpy()

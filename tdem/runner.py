@@ -345,7 +345,7 @@ class Runner:
         """The servo-controlled meshes' rows (:func:`tdem.step.servo_meshes`), from
         ``_mesh_servo`` (mesh index -> k, target, direction, relaxation, speed limit);
         None when no mesh has a servo."""
-        servo = getattr(self, "_mesh_servo", {})
+        servo = self._mesh_servo
         if not servo or not self._built:
             self._mservo_arr = None
             return
@@ -356,7 +356,7 @@ class Runner:
                 first, count, k, target
             rows[r, stepk.MS_DX:stepk.MS_DZ + 1] = d
             rows[r, [stepk.MS_ALPHA, stepk.MS_VMAX]] = relax, vmax
-        arr = getattr(self, "_mservo_arr", None)
+        arr = self._mservo_arr
         if arr is None or tuple(arr.shape) != rows.shape:
             arr = ti.ndarray(ti.f64, shape=rows.shape)
         arr.from_numpy(rows)
@@ -417,7 +417,7 @@ class Runner:
         gp = a["gridp"].to_numpy()
         gn = a["gridn"].to_numpy()
         self._last_fit = self._steps
-        bulk = getattr(self, "_grid_bulk", None)
+        bulk = self._grid_bulk
         if not force:
             cur_lo = gp[:d]
             cur_hi = cur_lo + gp[d] * gn[:d]
@@ -779,7 +779,7 @@ class Runner:
                               a["cs"], a["flags"], float(self._dt_run), limit, self.dim)
         flags = launch.host_copy(a["flags"])
         if (0 < flags[F_FAST] <= self._n and flags[F_BAD] >= self._n
-                and not getattr(self, "_fast_warned", False)):
+                and not self._fast_warned):
             self._warn_fast(int(flags[F_FAST]) - 1)
         return flags
 
@@ -809,7 +809,7 @@ class Runner:
                tuple((type(law).__name__, tuple(law.values()),
                       law.rolling.delta if law.rolling is not None else 0.0)
                      for law in self._laws))
-        if self._n < 7 or getattr(self, "_dense_checked", None) == key:
+        if self._n < 7 or self._dense_checked == key:
             return
         self._dense_checked = key
         stable = self.stable_dt()
@@ -925,7 +925,7 @@ class Runner:
         packing's bound is that of six contacts a particle, most have fewer); once
         per simulation."""
         if (self._cont is not None or self._n < 7 or self._has_shapes
-                or getattr(self, "_stiff_warned", False)
+                or self._stiff_warned
                 or not all(type(law).__name__ == "HertzMindlin" for law in self._laws)):
             return
         a = self._a
@@ -1004,7 +1004,7 @@ class Runner:
         runs as loose discs; element water (a Fluid without ``voronoi=True``) on a
         hexagonal lattice, under gravity, carries only part of ρgh. Each warning
         gives the elements made and what to change."""
-        if getattr(self, "_silent_checked", False):
+        if self._silent_checked:
             return
         self._silent_checked = True
         if self._cont is None or not self._cont.has_pcmm:

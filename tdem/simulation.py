@@ -217,6 +217,12 @@ class Simulation(Runner, Results):
         self._motions = {}         # (kind, index) -> (first, count, velocity, angular velocity)
         self._mesh_servo = {}      # 3D: mesh index -> (k, target, direction, relaxation, vmax)
         self._mservo_arr = None    # ... their rows on the device (tdem.step.servo_meshes)
+        self._dt_run = None        # the step the device runs with (set by _upload_params)
+        self._grid_bulk = None     # the cell grid's bulk box, when it covers only the bulk
+        self._fast_warned = False  # warnings given once: a particle faster than R a step,
+        self._stiff_warned = False  # a contact stiffer than the step allows,
+        self._silent_checked = False   # a model with nothing moving it
+        self._dense_checked = None     # (key) the dense-packing step check done for
         self._fixes = []           # (ids, vx, vy, omega) prescribed velocities
         self._n = 0
         self._built = False

@@ -177,7 +177,11 @@ def _all_arrays(sim):
 
 def test_history_columns_follow_the_registered_laws():
     from physics import contact_law as cl
-    laws = cl.registered()
+    # the laws registered at import (tdem.WetContact and tdem.Granular, with wider
+    # histories, register when first made)
+    laws = tuple(c for c in cl.registered() if c.__module__ in
+                 ("physics.linear", "physics.hertz_mindlin", "physics.volume_contact"))
+    assert len(laws) == 3
     assert cl.history_width(laws) == 1 and cl.pair_history_width(laws) == 7
     assert cl.wall_history_width(laws) == 5      # law, rolling (3), shape state
     h = np.arange(10.0).reshape(2, 5)
