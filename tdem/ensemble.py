@@ -358,23 +358,32 @@ def ensemble(fn, params, client=None, out=None, *, workers=None, threads=None,
     """Run ``fn(**p)`` for every ``p`` of ``params`` on a Dask cluster; returns
     :class:`Results` (``.rows`` in the order of ``params``).
 
-    fn : a function of keyword arguments returning a dict of numbers (or strings,
+    Parameters
+    ----------
+    fn
+        A function of keyword arguments returning a dict of numbers (or strings,
         lists), or one value (a number, a path: the column ``result``); it runs on
-        the workers, so it must be importable there (or picklable by value)
-    params : a list of dicts, or a dict of lists (their Cartesian product,
-        :func:`grid`)
-    client : a ``distributed.Client``, a scheduler address (``"tcp://host:8786"``),
-        or None: a ``LocalCluster`` of ``workers`` processes (default: this
-        machine's cores), one thread each, closed at the end
-    out : a folder: each member kept in ``out/members/<key>.json`` as it ends, the
+        the workers, so it must be importable there (or picklable by value).
+    params
+        A list of dicts, or a dict of lists (their Cartesian product, :func:`grid`).
+    client
+        A ``distributed.Client``, a scheduler address (``"tcp://host:8786"``), or
+        None: a ``LocalCluster`` of ``workers`` processes (default: this machine's
+        cores), one thread each, closed at the end.
+    out
+        A folder: each member kept in ``out/members/<key>.json`` as it ends, the
         table in ``out/results.csv`` and ``out/results.h5``; members already there
-        (``ok``) are read back and not run again. None: nothing written
-    workers : processes of the local cluster (``client=None`` only)
-    threads : Taichi CPU threads of each worker (default: ``$TDEM_THREADS`` where
-        the worker has it, else its machine's cores over its workers)
-    progress : a progress bar on stderr (tqdm); False: none
-    on_result : called here as ``on_result(row)`` as each member ends (not for
-        those read back)
+        (``ok``) are read back and not run again. None: nothing written.
+    workers
+        Processes of the local cluster (``client=None`` only).
+    threads
+        Taichi CPU threads of each worker (default: ``$TDEM_THREADS`` where the
+        worker has it, else its machine's cores over its workers).
+    progress
+        A progress bar on stderr (tqdm); False: none.
+    on_result
+        Called here as ``on_result(row)`` as each member ends (not for those read
+        back).
     """
     if not callable(fn):
         raise InputError(f"fn must be callable (a function of the parameters), got {fn!r}")

@@ -7,7 +7,7 @@ Conventions
   triangle **counter-clockwise** (positive signed area).
 - A boundary edge (a, b) is an edge used by exactly one triangle, oriented as in
   that triangle: the mesh lies to the *left* of a→b and the outward unit normal
-  is to the *right*, n = (b_y − a_y, −(b_x − a_x)) / |b − a|. The boundary edges
+  is to the *right*, n = (b_y − a_y, −(b_x − a_x)) / ‖b − a‖. The boundary edges
   of a simply connected mesh then chain into one counter-clockwise loop.
 - Lumped nodal masses of a block (physics notes §4): each triangle gives ρ·S/3
   to each of its nodes (unit thickness).

@@ -707,7 +707,7 @@ class Simulation(Runner, Results):
 
     def detonate(self, target, point, time=0.0):
         """Programmed burn of JWL particles (:class:`tdem.JWL`): particle i lights at
-        t_l = ``time`` + |x_i − ``point``|/D (positions now) and releases its pressure
+        t_l = ``time`` + ‖x_i − ``point``‖/D (positions now) and releases its pressure
         over the next 3R/D (the burn fraction). ``target``: particle indices or a
         :class:`ParticleGroup` of JWL particles. Unlit JWL particles have no pressure.
         """
