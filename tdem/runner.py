@@ -223,6 +223,7 @@ class Runner:
     def _rebuild_from(self, state, new_particles=None):
         """(Re)allocate every array for the current sizes and fill it from ``state``."""
         self._built_roll3d = self._rolling3d
+        self._built_range = self._law_range
         self._set_law_set(state)
         if new_particles is not None:
             pos, vel, r, rho, law, shape, ang, om = new_particles
@@ -849,9 +850,11 @@ class Runner:
             self._flow_events(self._time + self.check_interval * self.dt)
         if not self._built:
             self._build()
-        elif self._n and self._built_roll3d != self._rolling3d:
+        elif self._n and (self._built_roll3d != self._rolling3d
+                          or self._built_range != self._law_range):
             # 3D rolling resistance switched on or off (law.update) since the arrays were
-            # built: the contacts' rolling columns are added (at zero) or dropped
+            # built: the contacts' rolling columns are added (at zero) or dropped; or a
+            # law's range changed: the lists reach as far, the step evaluates gaps
             self._rebuild_from(self._download())
         if self._n:
             self._upload_laws()      # a law's parameters may have changed since (law.update)

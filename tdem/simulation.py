@@ -187,6 +187,7 @@ class Simulation(Runner, Results):
         self._laws = []            # ContactLaw objects, index = law id
         self._law_set = _claw.registered()   # the law classes the kernels compile for
         self._built_roll3d = False           # the arrays hold 3D rolling columns
+        self._built_range = 0.0              # ... and lists for the laws' range then
         self._pair_override = {}   # (law a, law b) -> law id
         self._groups = []
         self._host = {k: [] for k in ("pos", "vel", "radius", "density", "law", "mat", "shape",

@@ -335,3 +335,15 @@ def test_a_bridge_to_a_wall_holds_across_the_gap_to_its_rupture(dim):
     sim.run(steps=int(s_rup / (v * dt)) - 7000 + 5)
     assert len(sim.contacts.numpy()["pairs"]) == 0
     assert np.abs(sim.particles.numpy()["force"]).max() == 0.0
+
+
+def test_a_range_changed_between_runs_takes_effect(sticky):
+    """law.update(reach=...) after a run: the lists and the step follow the new range."""
+    law = sticky(kn=1e4, ka=1e-3, reach=R)
+    sim = _pair(3, law, 1.5 * R)
+    sim.run(steps=2)
+    assert sim.particles.numpy()["velocity"][1, 0] == 0.0
+    law.update(reach=2 * R)
+    sim.run(steps=1)
+    assert sim.particles.numpy()["velocity"][1, 0] == pytest.approx(
+        -1e-3 / _mass(3) * sim.dt, rel=1e-12)
