@@ -43,7 +43,8 @@ the bed rings about it, the rms is in the data); no non-converged ellipsoid cont
 the paper's "about 257" bottom-plate contacts, per 100 m² of box, averaged over the
 compression, within ±15 %, and their being "almost constant" (the mean over the
 snapshots within 10 % of the settled bed's count). The two bounds on the contact
-count are ours: the paper gives none.
+count are ours: the paper gives none. The second is compared in the paper preset
+only (about 300 contacts on its bottom plate); the quick preset reports it (below).
 
 Reported beside the paper (no pass/fail): the load shares of the measured forces on
 both plates beside Mueth's and the q-model's; which model is the closer (the smaller
@@ -60,10 +61,25 @@ The quick preset's bed has 40–50 contacts on its bottom plate (the paper's 257
 about 450 and 150 forces, and its 10 snapshots, all within a few mm of plate travel,
 share most of their contacts: its load shares are those of one small bed. In other
 beds of the quick set-up (other initial placements and settling dampings) the share that f ≥ 2 carries ranged over 31–42 % on the bottom plate and
-21–49 % on the loading plate (Mueth: 27.4 %, q-model: 15.1 %), and the
+21–49 % on the loading plate (Mueth: 27.4 %, q-model: 15.1 %; the preset's own bed,
+seed 1, read 53 % and 60 % on 2026-12-07 and 22 % and 51 % on 2026-12-06, at an
+earlier engine), and the
 Kolmogorov–Smirnov distance put both plates nearer Mueth's fit every time: the
 loading plate's forces spread wider than the q-model's, unlike the paper's, but with
-15 contacts that says little. The stress–settlement curve has the paper's shape: a
+15 contacts that says little.
+
+The change of the bottom plate's contact count (mean over the snapshots against the
+settled bed) is not resolved by the quick bed's 45–51 contacts, one of which is 2 %:
+over six beds of the quick preset (seeds 1–6, settling Δt 7.32e-5 s) it read −0.122,
+−0.048, −0.075, −0.106, −0.212 and −0.033 (mean −0.099, sample standard deviation
+0.065; three of six beyond ±0.1), and with the settling step shortened the bed of
+seed 1 read −0.102 (Δt 5.49e-5 s) and −0.037 (3.66e-5 s), that of seed 2 −0.046
+and −0.020. The bound of 10 % sits at the mean of that spread, so the quick preset
+reports the change; the paper preset (one run: 302 settled, 285.5 over the
+snapshots, −0.055) compares it. The count fluctuates during the compression too:
+its least in these beds was 32–41.
+
+The stress–settlement curve has the paper's shape: a
 long initial settlement (the plate first meets the tips of the highest particles and
 pushes them down through a rough top, the stress rising and falling as particles
 topple), then a steep, almost linear rise above 400 kPa. The paper preset runs as it
@@ -161,13 +177,17 @@ PAPER_BOTTOM_CONTACTS = 257          # on the 10 x 10 m bottom plate
 PAPER_AREA = 100.0
 PAPER_PARTICLES, PAPER_REMOVED = 1500, 31
 
+#: bound on (mean bottom-plate contacts over the snapshots − settled bed) / settled bed
+#: (ours: the paper says "almost constant"); compared in the presets that say so
+CONTACTS_CHANGE_BOUND = 0.10
+
 PRESETS = {
     "quick": {"particles": 240, "box": 4.0, "plate_speed": 0.2, "dt": 2e-5,
               "settle_damping": 2.0, "settle_fraction": 0.8, "settle_time": (15.0, 8.0),
-              "calm": 1e-8, "vtu_frames": 20, "seed": 1},
+              "calm": 1e-8, "vtu_frames": 20, "seed": 1, "compare_contacts_change": False},
     "paper": {"particles": 1500, "box": 10.0, "plate_speed": 0.02, "dt": DT,
               "settle_damping": 2.0, "settle_fraction": 0.8, "settle_time": (30.0, 15.0),
-              "calm": 1e-8, "vtu_frames": 40, "seed": 1},
+              "calm": 1e-8, "vtu_frames": 40, "seed": 1, "compare_contacts_change": True},
 }
 
 
@@ -438,6 +458,24 @@ def compress(sim, floor, hm, cfg, out=None, log=common.say):
 
 
 # ------------------------------------------------------------------ analysis
+def contacts_change_check(change, compare):
+    """The check of the bottom plate's contact count over the compression: ``change``
+    = (mean over the snapshots − settled bed) / settled bed, within
+    ±:data:`CONTACTS_CHANGE_BOUND` where ``compare``, else reported only (the quick
+    bed: 45–51 contacts, whose change spread from −0.21 to −0.03 over six beds)."""
+    note = ("(mean over the snapshots − settled bed) / settled bed; paper: almost "
+            "constant during compression")
+    if compare:
+        return common.check("bottom.contacts_change", change, 0.0,
+                            common.absolute(CONTACTS_CHANGE_BOUND), "",
+                            note + f" (our bound {100 * CONTACTS_CHANGE_BOUND:.0f} %)")
+    return common.check("bottom.contacts_change", change, 0.0, None, "",
+                        note + "; reported: with 45-51 contacts the change ranged over "
+                        "−0.21 to −0.03 in six beds of this preset (mean −0.10), as wide as "
+                        f"the {100 * CONTACTS_CHANGE_BOUND:.0f} % bound that the paper "
+                        "preset compares")
+
+
 def pooled(snaps, key):
     """The normal forces of ``key`` ("plate_force" / "floor_force") of every snapshot,
     each divided by its snapshot's mean."""
@@ -710,9 +748,7 @@ def main(argv=None):
                      PAPER_BOTTOM_CONTACTS, common.rel(0.15), "",
                      "mean over the compression, per 100 m² of box; paper: about 257 "
                      "(our bound ±15 %)"),
-        common.check("bottom.contacts_change", bottom_change, 0.0, common.absolute(0.10), "",
-                     "(mean over the snapshots − settled bed) / settled bed; paper: almost "
-                     "constant during compression (our bound 10 %)"),
+        contacts_change_check(bottom_change, cfg["compare_contacts_change"]),
         common.check("bottom.load_shares", pct(res["bottom"]["load_share"]),
                      list(QUOTED["mueth"]), None, "%",
                      "f < 0.5, 0.5-2, > 2 of the bottom plate's forces beside Mueth's fit "

@@ -92,6 +92,22 @@ def test_loose_bed_keeps_bounding_spheres_apart_across_the_periodic_sides():
     assert pos[:, 2].min() > max(ec.SEMI_AXES)
 
 
+def test_contacts_change_is_compared_in_the_paper_preset_only():
+    """The bottom plate's contact change against its 10 % bound: compared in the paper
+    preset (its run: 302 contacts settled, 285.5 over the snapshots), reported in the
+    quick one, whose 45-51 contacts leave the change spread over -0.21 to -0.03."""
+    assert ec.PRESETS["paper"]["compare_contacts_change"] is True
+    assert ec.PRESETS["quick"]["compare_contacts_change"] is False
+    c = ec.contacts_change_check((285.5 - 302) / 302, True)
+    assert c["value"] == pytest.approx(-0.0546, abs=1e-4)
+    assert c["tolerance"] == common.absolute(0.10) and c["pass"] is True
+    assert ec.contacts_change_check(-0.1222, True)["pass"] is False
+    q = ec.contacts_change_check(-0.1222, False)
+    assert q["name"] == "bottom.contacts_change"
+    assert q["value"] == pytest.approx(-0.1222, abs=1e-12)
+    assert q["tolerance"] is None and q["pass"] is None
+
+
 # ------------------------------------------------------------ a small bed
 TINY = {"particles": 9, "box": 2.7, "plate_speed": 0.2, "dt": ec.DT, "settle_damping": 5.0,
         "settle_fraction": 0.8, "settle_time": (3.0, 3.0), "calm": 1e-8, "vtu_frames": 4,
@@ -167,6 +183,7 @@ def test_quick_preset(tmp_path):
     for name in ("mueth.load_shares_formula", "q_model.load_shares_formula",
                  "bed.static_balance", "nonconverged_contacts"):
         assert c[name]["pass"] is True, name
+    assert c["bottom.contacts_change"]["pass"] is None          # reported in this preset
     for plate in ("loading", "bottom"):
         p = s["data"]["plates"][plate]
         assert p["histogram_integral"] == pytest.approx(1.0, abs=1e-9)
