@@ -292,6 +292,17 @@ def _aim(case, preset, s):
     return f"≤ {common.duration(aim)}{where}: {met}"
 
 
+def _heading(case, s):
+    """The section heading of a kept run in docs/validation.md."""
+    return f"`{case}`, {label(s)}" + ("" if s.get("variant") else " preset")
+
+
+def _slug(heading):
+    """The anchor GitHub and MyST (``myst_heading_anchors``) give a heading: lower case,
+    punctuation other than ``-`` and ``_`` dropped, spaces made ``-``."""
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
 def render_validation(runs, link="validation"):
     """The text of docs/validation.md for the kept runs ``runs`` (:func:`kept`);
     ``link``: the kept runs' folder relative to the report."""
@@ -305,13 +316,12 @@ def render_validation(runs, link="validation"):
              "| --- | --- | --- | --- | --- | --- | --- |"]
     for case, preset, s, _ in runs:
         n = s["counts"]
-        lines.append(f"| [`{case}`](#{case}-{preset}) | {label(s)} | "
+        lines.append(f"| [`{case}`](#{_slug(_heading(case, s))}) | {label(s)} | "
                      f"{common.duration(s['wall_time_s'])} | {_cell(how_measured([s]))} | "
                      f"{n['passed']} of {n['passed'] + n['failed']} | {verdict(s)} | "
                      f"{_aim(case, preset, s)} |")
     for case, preset, s, plots in runs:
-        lines += ["", f'<a id="{case}-{preset}"></a>', "",
-                  f"## `{case}`, {label(s)}" + ("" if s.get("variant") else " preset"), ""]
+        lines += ["", f"## {_heading(case, s)}", ""]
         if s.get("paper"):
             what = _cell(WHAT.get(case, ""))
             lines += [f"{what[:1].upper()}{what[1:]}; paper: {s['paper']}.", ""]

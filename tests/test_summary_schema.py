@@ -199,7 +199,7 @@ def test_validation_report_keeps_runs_and_lists_their_figures(tmp_path):
                                                            ["fig19.png"])]
     text = report.render_validation(runs)
     row = [ln for ln in text.splitlines() if ln.startswith("| [`soil_cutting`]")]
-    assert row == ["| [`soil_cutting`](#soil_cutting-paper) | paper | 90 min | "
+    assert row == ["| [`soil_cutting`](#soil_cutting-paper-preset) | paper | 90 min | "
                    "--threads 1 on 2 CPU cores, 2026-12-04 | 2 of 3 | FAIL | "
                    "≤ 120 min on 2 cores: met |"]
     assert report.render_check(s["checks"][3]) in text
@@ -230,7 +230,8 @@ def test_a_variant_is_kept_beside_its_preset(tmp_path):
     assert [f for _, f, _, _ in runs] == ["paper", "paper-cells-four"]
     rows = [ln for ln in report.render_validation(runs).splitlines()
             if ln.startswith("| [`soil_cutting`]")]
-    assert rows[0].startswith("| [`soil_cutting`](#soil_cutting-paper) | paper | 90 min")
+    # (the links are the headings' anchors, as GitHub and MyST make them)
+    assert rows[0].startswith("| [`soil_cutting`](#soil_cutting-paper-preset) | paper | 90 min")
     assert rows[0].endswith("≤ 120 min on 2 cores: met |")
     assert rows[1].startswith("| [`soil_cutting`](#soil_cutting-paper-cells-four) | "
                               "paper, cells-four | 150 min")
