@@ -228,6 +228,9 @@ class ContactLaw:
     tangential = ()
     rolling = None
     range = None         # the name of the param that gives the law's range (m), if any
+    #: its normal stiffness grows as sqrt(overlap) (Hertz): the runner checks after a
+    #: run that the step still suits the largest overlap
+    hertzian = False
 
     def acting_range(self):
         """The distance (m) across which the law acts: the value of the param that

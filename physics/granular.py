@@ -353,6 +353,10 @@ class Granular(ContactLaw):
         self.damping = damping if damping is not None else Ratio(0.0)
         self._set_rolling(rolling)
 
+    @property
+    def hertzian(self):
+        return isinstance(self.normal, Hertz)
+
     def values(self):
         d = self.damping
         if isinstance(d, Restitution):

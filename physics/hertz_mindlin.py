@@ -35,6 +35,7 @@ class HertzMindlin(ContactLaw):
     params = ("e_star", "g_star", "friction", "cohesion", "damping_ratio", "_gamma")
     history = ("shear",)
     tangential = ("shear",)
+    hertzian = True
 
     def __init__(self, *, young, poisson, friction=0.5, restitution=None, cohesion=0.0,
                  damping_ratio=0.0, rolling=None):

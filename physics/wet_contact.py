@@ -67,6 +67,10 @@ class WetContact(ContactLaw):
         self.rolling = dry.rolling
 
     @property
+    def hertzian(self):
+        return self.dry.hertzian
+
+    @property
     def dry_kind(self):
         return float(DRY.index(type(self.dry)))
 

@@ -923,13 +923,13 @@ class Runner:
         the radius: a bed pressed harder needs a smaller one, by (0.05 R/δ)^(1/4) at
         its largest overlap δ. Without this the bed jitters at speed under damping,
         its walls disagree and its integration makes energy, none of it reported.
-        Checked after each run of a sphere model whose laws are all Hertz–Mindlin (of
+        Checked after each run of a sphere model whose laws are all Hertzian (of
         seven particles or more), with a margin (``STIFFENED_MARGIN``: the dense
         packing's bound is that of six contacts a particle, most have fewer); once
         per simulation."""
         if (self._cont is not None or self._n < 7 or self._has_shapes
                 or self._stiff_warned
-                or not all(type(law).__name__ == "HertzMindlin" for law in self._laws)):
+                or not all(law.hertzian for law in self._laws)):
             return
         a = self._a
         ratio = float(stepk.largest_overlap_ratio(a["cs"], a["nbr"], a["ncnt"], a["wcs"],

@@ -204,3 +204,13 @@ def test_bad_granular_input_is_named():
             tdem.register_submodel(Late)
     finally:
         G._USED[0] = used
+
+
+def test_the_laws_say_whether_they_stiffen_as_hertz():
+    """The runner's check of a pressed bed's step (tests/test_energy.py) reads
+    ``law.hertzian``: Hertz–Mindlin, a Granular law of Hertz normal, a wet Hertz law."""
+    hm = tdem.HertzMindlin(young=1e8, poisson=0.3)
+    assert hm.hertzian and not tdem.LinearContact(kn=1e5).hertzian
+    assert tdem.Granular(normal=G.Hertz(1e8, 0.3), tangential=G.Mindlin(1e8, 0.3)).hertzian
+    assert not tdem.Granular(normal=G.Hooke(1e5), tangential=G.LinearHistory(1e5)).hertzian
+    assert tdem.WetContact(hm, tdem.LiquidBridge(volume=1e-12)).hertzian
