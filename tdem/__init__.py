@@ -1,8 +1,12 @@
 """tdem: continuum–discontinuum simulation in geomechanics, on Taichi.
 
 The public API (see docs/api.md): :class:`Simulation`, the contact laws
-:class:`LinearContact`, :class:`HertzMindlin`, :class:`VolumeContact` (polyhedra), :class:`RollingResistance`, :class:`ParallelBond` (bonded particles, ``sim.bond``) (and
-:class:`ContactLaw` with :func:`register_law` for laws of one's own), the
+:class:`LinearContact`, :class:`HertzMindlin`, :class:`VolumeContact` (polyhedra),
+:class:`Granular` (composed of sub-models, :mod:`physics.granular`, with
+:func:`register_submodel`), :class:`WetContact` (liquid bridges made at contact),
+:class:`RollingResistance`, :class:`ParallelBond` and :class:`LiquidBridge` (bonded
+particles, ``sim.bond``) (and :class:`ContactLaw` with :func:`register_law` for laws of
+one's own, which may act across a gap), the
 continuum materials :class:`Elastic`, :class:`MohrCoulomb`, :class:`Fluid`, :class:`JWL`, the
 geometry helpers :mod:`tdem.pack` and :mod:`tdem.mesh`, and the errors
 :class:`InputError`, :class:`InstabilityError`; :func:`plot_history` plots monitor
