@@ -806,12 +806,23 @@ def plot_specimen(spec, png, title):
 PHI_TOL = 2.0
 
 
+# what is known of the angles below the paper's (docs/cases.md, biaxial): measured not to
+# be the cause, and the lead
+BELOW_NOTE = ("below the paper's, as every angle here (4–6°): not the loading rate "
+              "(converged at 0.1 /s: 20.3° against 19.3–19.7° at 0.05–0.025 /s, no rolling "
+              "resistance), the specimen (three seeds: sd ≤ 2.5°) or the local damping "
+              "(0.2 reads weaker); the lead, not yet shown: the specimen's state at "
+              "e = 0.25, where φ moves fast with e (quick: 22.1° at e 0.254, 24.6° at 0.245)")
+
+
 def _phi_check(name, value, target, note):
+    below = target is not None and value < target - PHI_TOL
     return common.check(name, value, target,
                         common.absolute(PHI_TOL) if target is not None else None, "deg",
                         note + (f"; within {PHI_TOL:g}°, the scatter of one test (module "
                                 "docstring)" if target is not None else
-                                "; no paper value for this material"))
+                                "; no paper value for this material")
+                        + (f"; {BELOW_NOTE}" if below else ""))
 
 
 def _figures(results, rate_note=""):
