@@ -91,6 +91,11 @@ class NormalModel(SubModel):
 class DampingModel(SubModel):
     kind = "damping"
 
+    def values_for(self, normal):
+        """Its parameter columns beside the normal model ``normal`` (by default its
+        ``values()``)."""
+        return self.values()
+
 
 class TangentialModel(SubModel):
     kind = "tangential"
@@ -217,7 +222,7 @@ class Restitution(DampingModel):
     γ: a linear spring's Miyata Eq. 17, Hertz's with Antypov & Elliott's factor); no
     tangential dashpot."""
 
-    params = ("_gamma",)
+    params = ("gamma",)
 
     def __init__(self, e):
         try:
@@ -227,7 +232,9 @@ class Restitution(DampingModel):
         if not 0.0 < e <= 1.0:
             raise InputError(f"restitution must lie in (0, 1], got {e!r}")
         self.e = e
-        self._gamma = 0.0
+
+    def values_for(self, normal):
+        return [normal.restitution_gamma(self.e) if self.e < 1.0 else 0.0]
 
     @staticmethod
     @ti.func
@@ -267,9 +274,10 @@ class LinearHistory(TangentialModel):
 
 
 @register_submodel
-class Mindlin(TangentialModel):
+class Mindlin(LinearHistory):
     """Mindlin's tangential stiffness k_s = 8 G* sqrt(R* u) (Miyata Eq. 31), used
-    incrementally with the Coulomb limit; 1/G* = 2(2 − ν)/G, G = E/(2(1 + ν))."""
+    incrementally with the Coulomb limit as :class:`LinearHistory` (its force and
+    energy); 1/G* = 2(2 − ν)/G, G = E/(2(1 + ν))."""
 
     params = ("g_star", "friction", "cohesion")
 
@@ -292,16 +300,6 @@ class Mindlin(TangentialModel):
     @ti.func
     def stiffness(q, u, reff):
         return 8.0 * q[0] * ti.sqrt(reff * u)
-
-    @staticmethod
-    @ti.func
-    def force(q, fn_el, ks, cs, vt, dt, h):
-        return _history_shear(q[1], q[2], fn_el, ks, cs, vt, dt, h)
-
-    @staticmethod
-    @ti.func
-    def energy(q, ks, h, T: ti.template()):
-        return shear_spring_energy(h, ks, T)
 
 
 @ti.func
@@ -358,12 +356,10 @@ class Granular(ContactLaw):
         return isinstance(self.normal, Hertz)
 
     def values(self):
-        d = self.damping
-        if isinstance(d, Restitution):
-            d._gamma = self.normal.restitution_gamma(d.e) if d.e < 1.0 else 0.0
         out = [float(type(m).code) for m in (self.normal, self.damping, self.tangential)]
         for kind in KINDS:
-            v = getattr(self, kind).values()
+            m = getattr(self, kind)
+            v = m.values_for(self.normal) if kind == "damping" else m.values()
             out += v + [0.0] * (WIDTHS[kind] - len(v))
         return out
 

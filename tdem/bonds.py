@@ -17,7 +17,7 @@ import numpy as np
 import taichi as ti
 
 from physics.geometry.frame import moment, pack, spin_cross, vec_zero
-from physics.liquid_bridge import A1, A2, bridge_g
+from physics.liquid_bridge import willett
 from physics.parallel_bond import (BP_AREA, BP_CAP_F0, BP_CAP_K, BP_COHESION, BP_D0,
                                    BP_INERTIA, BP_KN_A, BP_KN_I, BP_KS_A, BP_KS_J, BP_POLAR,
                                    BP_RBAR, BP_RUPTURE, BP_SIGMA_C, BP_TANPHI, BP_TYPE)
@@ -89,11 +89,7 @@ def bond_forces(pos: ti.types.ndarray(), vel: ti.types.ndarray(),
                 bstate[b][BS_FS_BREAK] = 0.0
                 bstate[b][BS_POT] = 0.0
             else:
-                x = p[BP_CAP_K] * ti.max(gap, 0.0)
-                f = p[BP_CAP_F0] / (1.0 + A1 * x + A2 * x * x)
-                pot = p[BP_CAP_F0] / p[BP_CAP_K] * (
-                    bridge_g(p[BP_CAP_K] * p[BP_RUPTURE]) - bridge_g(x)) \
-                    + p[BP_CAP_F0] * ti.max(-gap, 0.0)
+                f, pot = willett(p[BP_CAP_F0], p[BP_CAP_K], p[BP_RUPTURE], gap)
                 bstate[b][BS_FN] = -f
                 bstate[b][BS_POT] = -pot          # bound: below the ruptured state
                 fj = -f * n
