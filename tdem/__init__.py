@@ -34,7 +34,7 @@ from .plot import plot_history
 from .errors import CapacityError, InputError, InstabilityError
 from .pack import random_orientations
 from .gradings import Grading, grading
-from .simulation import Block, Mesh, ParticleGroup, Simulation, Wall
+from .simulation import Block, Mesh, ParticleGroup, Primitive, Simulation, Wall
 from .cell import TriaxialCell
 from .ensemble import Results as _EnsembleResults, ensemble, grid as _grid
 
@@ -43,7 +43,7 @@ ensemble.Results = _EnsembleResults
 
 __version__ = "0.1.0"
 
-__all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Block", "surfaces",
+__all__ = ["Simulation", "ParticleGroup", "Wall", "Mesh", "Primitive", "Block", "surfaces",
            "random_orientations", "ContactLaw", "register_law",
            "LinearContact", "HertzMindlin", "VolumeContact", "Polyhedron",
            "RollingResistance", "PointEdge", "Superellipse", "Ellipsoid", "Elastic", "MohrCoulomb", "Fluid", "JWL", "InputError",

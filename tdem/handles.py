@@ -1,7 +1,8 @@
 """The handles a model hands back: particle groups, walls, blocks and result views.
 
 :class:`ParticleGroup` (what ``add_particles`` returns), :class:`Wall` (``add_wall``:
-velocity, servo control, the force it receives), :class:`Block` (``add_block``:
+velocity, servo control, the force it receives), :class:`Mesh` (``add_mesh``),
+:class:`Primitive` (``add_plane``, ``add_cylinder``), :class:`Block` (``add_block``:
 nodes, fixes, elements), and the small helpers that check the inputs they share.
 Each handle reads and writes the state of the :class:`tdem.Simulation` it belongs to.
 """
@@ -12,6 +13,7 @@ import numpy as np
 from physics.validate import indices
 
 from . import mesh as _mesh
+from . import primitives as _prims
 from . import step as stepk
 from .errors import InputError
 
@@ -515,6 +517,99 @@ class Mesh:
 
     def __repr__(self):
         return f"Mesh({self.index}, triangles={len(self._rows())})"
+
+
+class Primitive:
+    """A primitive wall (3D): an infinite plane (:meth:`tdem.Simulation.add_plane`) or
+    cylinder (:meth:`tdem.Simulation.add_cylinder`). It translates at :attr:`velocity`
+    (changeable between runs, or a function of time through :meth:`motion`);
+    :attr:`force` and :attr:`torque` are what it received in the last step."""
+
+    def __init__(self, sim, index):
+        self._sim = sim
+        self.index = index
+
+    def _row(self):
+        return self._sim._prim_rows()[self.index]
+
+    def _set(self, col, v):
+        rows = self._sim._prim_rows().copy()
+        rows[self.index, col:col + len(v)] = v
+        self._sim._set_prim_rows(rows)
+
+    @property
+    def kind(self):
+        """"plane" or "cylinder"."""
+        return _prims.KIND_NAMES[int(self._row()[_prims.PR_KIND])]
+
+    @property
+    def point(self):
+        """A point of the plane, or of the cylinder's axis, now (it moves with the wall)."""
+        return self._row()[_prims.PR_PX:_prims.PR_PX + 3].copy()
+
+    @property
+    def normal(self):
+        """The plane's unit normal (towards the particles), the cylinder's unit axis."""
+        return self._row()[_prims.PR_NX:_prims.PR_NX + 3].copy()
+
+    @property
+    def radius(self):
+        """The cylinder's radius (0 for a plane)."""
+        return float(self._row()[_prims.PR_RADIUS])
+
+    @property
+    def inside(self):
+        """Whether the particles are inside the cylinder (None for a plane)."""
+        k = int(self._row()[_prims.PR_KIND])
+        return None if k == _prims.PLANE else k == _prims.CYLINDER_IN
+
+    @property
+    def velocity(self):
+        return self._row()[_prims.PR_VX:_prims.PR_VX + 3].copy()
+
+    @velocity.setter
+    def velocity(self, v):
+        self._set(_prims.PR_VX, _vector2("velocity", v, 3))
+
+    @property
+    def angular_velocity(self):
+        """A primitive does not turn: (0, 0, 0)."""
+        return np.zeros(3)
+
+    @angular_velocity.setter
+    def angular_velocity(self, w):
+        if np.any(_vector2("angular_velocity", w, 3) != 0.0):
+            raise InputError(f"angular_velocity: a primitive wall translates only, got {w!r}")
+
+    def motion(self, velocity=None):
+        """Move this wall by a function of time: ``velocity`` (3 numbers, m/s), a
+        constant or a function of the time t (s) returning them, evaluated at the
+        start of every step (``tdem.motion.vibration``, ``tdem.motion.ramp``; a
+        checkpoint keeps those). None holds it at rest; ``motion()`` stops it."""
+        return _set_motion(self, "primitive", self.index, 1, velocity, None, None, 3)
+
+    @property
+    def force(self):
+        """Total contact force (3,) the wall received in the last step."""
+        return self._sim._prim_loads()[self.index, :3].copy()
+
+    @property
+    def torque(self):
+        """Moment (3,) of the contact forces about :attr:`point` in the last step."""
+        return self._sim._prim_loads()[self.index, 3:6].copy()
+
+    @property
+    def contacts(self):
+        """The number of particles that touched it in the last step."""
+        return int(self._sim._prim_loads()[self.index, 6])
+
+    def __repr__(self):
+        r = self._row()
+        if int(r[_prims.PR_KIND]) == _prims.PLANE:
+            return f"Primitive({self.index}, plane, point={self.point.tolist()}, " \
+                   f"normal={self.normal.tolist()})"
+        return f"Primitive({self.index}, cylinder, point={self.point.tolist()}, " \
+               f"axis={self.normal.tolist()}, radius={self.radius:g}, inside={self.inside})"
 
 
 class _View:

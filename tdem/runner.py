@@ -33,10 +33,12 @@ from physics.volume_contact import VolumeContact
 
 from . import backend, launch, neighbors, sweep
 from . import bonds as _bonds
+from . import primitives as _prims
 from . import state as schema
 from . import step as stepk
 from .continuum import Continuum
 from .errors import CapacityError, InputError, InstabilityError
+from .primitives import PRIM_WIDTH
 from .neighbors import F_BAD, F_FAST, F_NEED, F_REBUILD, F_SWEEP, F_WALL_NEED, FLAGS_SIZE
 
 
@@ -127,7 +129,10 @@ class Runner:
                 "dim": self.dim, "shaped": self.dim == 3 and self._has_shapes,
                 "rolling": self._rolling3d, "pshapes": max(len(self._polys), 1),
                 "bonds": max(self._nbonds, 1),
-                "entries": 2 * n if self.broad_phase == "sweep" else 1}
+                "entries": 2 * n if self.broad_phase == "sweep" else 1,
+                # primitive walls: their contacts' arrays a row per particle only with them
+                "nprims": len(self._prims_host), "prims": max(len(self._prims_host), 1),
+                "pn": n if self._prims_host else 1}
 
     def _allocate(self, n, cap, capw, nwalls, nlaws, ncell):
         return schema.allocate(self._sizes(n, cap, capw, nwalls, nlaws, ncell), self._fdt)
@@ -249,6 +254,7 @@ class Runner:
         self._upload_polyhedra()
         self._set_wall_rows(np.array(self._walls_host).reshape(-1, stepk.wall_width(self.dim)),
                             fresh=True)
+        self._set_prim_rows(np.array(self._prims_host).reshape(-1, PRIM_WIDTH))
         self._fit_grid(force=True)
         self._apply_fixes(initial=True)
         self._apply_loads(initial=True)
@@ -294,6 +300,7 @@ class Runner:
         """Every device array as numpy; the host copy of the walls follows the device."""
         out = {k: self._a[k].to_numpy() for k in schema.saved()}
         self._walls_host = list(out["wall"][:len(self._walls_host)])
+        self._prims_host = list(out["prim"][:len(self._prims_host)])
         return out
 
     def _set_law_set(self, state):
@@ -378,6 +385,26 @@ class Runner:
         self._a["wall"].from_numpy(full)
         self._walls_host = list(rows)
         self._a["flags"][F_REBUILD] = 1
+
+    def _prim_rows(self):
+        """The primitive walls' rows (tdem.primitives.PR_*), from the device once built."""
+        if not self._built:
+            return np.array(self._prims_host, dtype=float).reshape(-1, PRIM_WIDTH)
+        return launch.host_copy(self._a["prim"])[:len(self._prims_host)]
+
+    def _set_prim_rows(self, rows):
+        self._prims_host = list(rows)
+        if not self._built:
+            return
+        full = np.zeros((max(len(rows), 1), PRIM_WIDTH))
+        full[:len(rows)] = rows
+        self._a["prim"].from_numpy(full)
+
+    def _prim_loads(self):
+        """(primitives, 7): force, moment about the point, contacts of the last step."""
+        if not self._built:
+            return np.zeros((len(self._prims_host), 7))
+        return launch.host_copy(self._a["pforce"])[:len(self._prims_host)]
 
     def _wall_loads(self):
         if not self._built:
@@ -569,6 +596,10 @@ class Runner:
         :func:`tdem.step.set_motion`; nothing is read back."""
         for (kind, index), (first, count, vel, ang) in self._motions.items():
             v = _motion_value(f"{kind} {index}: velocity", vel, t, self.dim)
+            if kind == "primitive":
+                if v is not None:
+                    _prims.set_velocity(self._a["prim"], first, *(float(x) for x in v))
+                continue
             w = _motion_value(f"{kind} {index}: angular_velocity", ang, t,
                               1 if self.dim == 2 else 3)
             vv = (0.0, 0.0, 0.0) if v is None else tuple(v) + (0.0,) * (3 - len(v))
@@ -603,7 +634,7 @@ class Runner:
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
                            chunk=self._chunk() > 0, loads=bool(self._loads_on),
                            bonds=self._nbonds > 0, ranged=self._law_range > 0.0,
-                           detail=False,
+                           prims=bool(self._prims_host), detail=False,
                            continuum=False, laws=self._law_set, shapes=False,
                            dim=self.dim)[:-5]
 

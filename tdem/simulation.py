@@ -33,10 +33,11 @@ from physics.validate import in_range, indices, non_negative
 from . import backend
 from . import mesh as _mesh
 from . import pack as _pack
+from . import primitives as _prims
 from . import step as stepk
 from .errors import InputError
-from .handles import (Block, Mesh, ParticleGroup, Wall, _View, _as_xy, _fix_value, _in_box,
-                      _vector2)
+from .handles import (Block, Mesh, ParticleGroup, Primitive, Wall, _View, _as_xy, _fix_value,
+                      _in_box, _vector2)
 from .bonds import BondView
 from .results import Results
 from .neighbors import F_BUILDS, F_NONCONV
@@ -215,6 +216,7 @@ class Simulation(Runner, Results):
         self._walls_host = []      # rows of the wall table
         self._periodic = [None] * self.dim   # (start, end) of the periodic x, y (z) axes
         self._meshes = []          # 3D: (first triangle row, number of rows) of each mesh
+        self._prims_host = []      # 3D: rows of the primitive walls (tdem.primitives.PR_*)
         self._motions = {}         # (kind, index) -> (first, count, velocity, angular velocity)
         self._mesh_servo = {}      # 3D: mesh index -> (k, target, direction, relaxation, vmax)
         self._mservo_arr = None    # ... their rows on the device (tdem.step.servo_meshes)
@@ -349,6 +351,10 @@ class Simulation(Runner, Results):
             if shape is not None and self._rolling3d:
                 raise InputError("shape: ellipsoids cannot join a model whose laws have "
                                  "rolling resistance (a sphere feature)")
+            if shape is not None and self._prims_host:
+                raise InputError(f"shape: primitive walls (add_plane, add_cylinder) take "
+                                 f"spheres only; got shape={shape!r} (use a mesh wall, "
+                                 f"add_mesh with tdem.surfaces.plane)")
         elif orientation is not None:
             raise InputError(f"orientation: a 2D particle's orientation is its angle= "
                              f"(got orientation={orientation!r})")
@@ -902,6 +908,58 @@ class Simulation(Runner, Results):
         """The mesh walls (3D), in the order added."""
         return [Mesh(self, k) for k in range(len(self._meshes))]
 
+    def add_plane(self, point, normal, contact=None, velocity=(0.0, 0.0, 0.0)):
+        """3D: add an infinite plane wall through ``point`` (3 numbers) with the unit
+        of ``normal`` pointing to the side the particles are on (LIGGGHTS' ``primitive
+        type xplane`` and the like, at any orientation); returns a
+        :class:`tdem.handles.Primitive`. No triangles: each sphere meets it as it would
+        a mesh face (:mod:`tdem.primitives`), with the law ``contact``. The plane
+        translates at ``velocity`` (m/s; :meth:`tdem.handles.Primitive.motion` for a
+        function of time): a piston or a lid. Spheres only (no ellipsoids or
+        polyhedra)."""
+        self._primitive_check("add_plane", contact)
+        row = _prims.plane_row(point, normal, 0, velocity)
+        return self._add_primitive(row, contact)
+
+    def add_cylinder(self, center, axis, radius, contact=None, inside=True,
+                     velocity=(0.0, 0.0, 0.0)):
+        """3D: add an infinite circular cylinder wall of ``radius`` about the line
+        through ``center`` along ``axis`` (LIGGGHTS' ``primitive type zcylinder``, at
+        any orientation); returns a :class:`tdem.handles.Primitive`. The particles are
+        inside it (``inside=True``: a drum, a silo) or outside (a post). It has no ends
+        (close it with :meth:`add_plane`). Same contact as :meth:`add_plane`; it
+        translates at ``velocity``. Spheres only."""
+        self._primitive_check("add_cylinder", contact)
+        row = _prims.cylinder_row(center, axis, radius, inside, 0, velocity)
+        return self._add_primitive(row, contact)
+
+    def _primitive_check(self, what, contact):
+        if self.dim != 3:
+            raise InputError(f"{what} is 3D: use tdem.Simulation(dim=3); a 2D simulation "
+                             "takes segment walls (add_wall)")
+        if self._n and self._has_shapes:
+            raise InputError(f"{what}: primitive walls take spheres only; this model has "
+                             "shaped particles (ellipsoids or polyhedra): use a mesh wall "
+                             "(add_mesh with tdem.surfaces.plane)")
+        if contact is None:
+            raise InputError("contact must be given: a law such as tdem.HertzMindlin(...)")
+        if isinstance(contact, VolumeContact):
+            raise InputError(f"contact: {contact!r} is the polyhedra's overlap-volume law; "
+                             "primitive walls take the spheres' laws")
+
+    def _add_primitive(self, row, contact):
+        row[_prims.PR_LAW] = self._law_id(contact)
+        state = self._download() if self._built else None
+        self._prims_host.append(row)
+        if state is not None:
+            self._rebuild_from(state)
+        return Primitive(self, len(self._prims_host) - 1)
+
+    @property
+    def primitives(self):
+        """The primitive walls (3D planes and cylinders), in the order added."""
+        return [Primitive(self, k) for k in range(len(self._prims_host))]
+
     def _refuse_2d_only(self, **given):
         """In 3D, refuse the arguments of 2D-only features, naming the first given."""
         for name, v in given.items():
@@ -1249,7 +1307,8 @@ class Simulation(Runner, Results):
         and, with continua, the shortest element altitude / c_p (PCMM elements in the
         initial configuration, block triangles)."""
         key = (self._n, len(self._laws), len(self._walls_host), len(self._pair_override),
-               sum(not ins.done for ins in self._inserters), self._nbonds)
+               sum(not ins.done for ins in self._inserters), self._nbonds,
+               len(self._prims_host))
         if self._crit_cache is None or self._crit_cache[0] != key:
             self._crit_cache = (key, self._critical_dt())
         return self._crit_cache[1]
@@ -1368,6 +1427,7 @@ class Simulation(Runner, Results):
         # (the law's column of a segment wall's row in 2D, of a mesh triangle's in 3D)
         col = stepk.W_LAW if self.dim == 2 else stepk.T_LAW
         wall_laws = {int(w[col]) for w in self._walls_host}
+        wall_laws |= {int(w[_prims.PR_LAW]) for w in self._prims_host}
         present = np.unique(plaw)
         for law_id in present:
             sel = plaw == law_id

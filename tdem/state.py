@@ -17,8 +17,10 @@ snapshot); ``scratch`` arrays are rebuilt whenever needed (neither).
 Owners and their shapes: ``particle`` (n,), ``slot`` (n, cap) the half neighbour
 list, ``wall_slot`` (n, capw) a particle's candidate walls, ``bond`` (bonds,) the
 bonds (:mod:`tdem.bonds`), ``wall`` (walls,),
-``wall_part`` (chunks, walls) per chunk of the step's pair loop, and fixed-size
-tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's or a wall
+``wall_part`` (chunks, walls) per chunk of the step's pair loop, ``prim_slot``
+(n, primitives) a particle's contacts with the primitive walls (one row, (1, 1), in a
+model without them), ``prim`` (primitives,), ``prim_part`` (chunks, primitives), and
+fixed-size tables. Components: 0 a scalar, k a k-vector, ``"H"`` / ``"HW"`` a pair's or a wall
 contact's history vector (as wide as the registered contact laws need,
 :mod:`physics.contact_law`).
 
@@ -36,6 +38,7 @@ from physics.polyhedron import PI_WIDTH, PT_WIDTH
 from .core.arrays import ndarray  # noqa: F401  (state.ndarray: the engine's arrays are made by it)
 from .core.launch import cached
 from .core.layout import PROP_INERTIA, PROP_MASS, PROP_RADIUS, PROP_WIDTH  # noqa: F401
+from .primitives import PRIM_WIDTH
 
 
 @dataclass(frozen=True)
@@ -108,6 +111,20 @@ ENGINE = (
     Array("wcs", "wall_slot", 3, "f", "dynamic", doc="F_n, F_s, overlap (output)"),
     Array("wid_old", "wall_slot", "i", "i32", "scratch", fill=-1, doc="before a rebuild"),
     Array("whist_old", "wall_slot", "HW", "f", "scratch", doc="before a rebuild"),
+    # primitive walls (3D planes and cylinders, tdem.primitives): every particle against
+    # every primitive (a dense table; one row in a model without them)
+    Array("phist", "prim_slot", "HW", "f", "dynamic", doc="primitive wall contact history"),
+    Array("pcn", "prim_slot", "D", "f", "dynamic",
+          doc="primitive wall contact normal (output)"),
+    Array("pcf", "prim_slot", {2: 4, 3: 6}, "f", "dynamic",
+          doc="primitive wall contact force, moment (output)"),
+    Array("pcs", "prim_slot", 3, "f", "dynamic", doc="F_n, F_s, overlap (output)"),
+    Array("prim", "table", ("prims", PRIM_WIDTH), "f64", "dynamic",
+          doc="primitive walls' rows (tdem.primitives.PR_*)"),
+    Array("pforce", "prim", 7, "f64", "dynamic",
+          doc="force, moment about the primitive's point, contacts received"),
+    Array("ppart", "prim_part", 7, "f64", "scratch",
+          doc="pforce's partial sums, one row per chunk of the step's pair loop"),
     # bonds (tdem.bonds): the pair, its properties, its forces and, once broken, its record
     Array("bpair", "bond", 2, "i32", "setup", fill=-1, doc="the bond's two particles"),
     Array("bprop", "bond", BP_WIDTH, "f64", "setup",
@@ -159,6 +176,12 @@ ENGINE = (
 BY_NAME = {a.name: a for a in ENGINE}
 
 
+def per_particle(nprims):
+    """The owners whose arrays have a row per particle: the primitive walls' contacts
+    too in a model with ``nprims`` > 0 primitives (without, their arrays are one row)."""
+    return ("particle", "slot", "wall_slot") + (("prim_slot",) if nprims else ())
+
+
 def dynamic():
     """Names of the arrays a snapshot restores."""
     return tuple(a.name for a in ENGINE if a.role == "dynamic")
@@ -204,7 +227,8 @@ def shape(a, sizes):
                      for s in a.comps), None
     lead = {"particle": ("n",), "slot": ("n", "cap"), "wall_slot": ("n", "capw"),
             "wall": ("walls",), "wall_part": ("chunks", "walls"),
-            "bond": ("bonds",)}[a.owner]
+            "prim_slot": ("pn", "prims"), "prim": ("prims",),
+            "prim_part": ("chunks", "prims"), "bond": ("bonds",)}[a.owner]
     comps = _comps(a, sizes)
     return tuple(sizes[s] for s in lead), (None if comps in (0, "i") else comps)
 
@@ -229,8 +253,9 @@ def fresh_rows(n, sizes, values):
     import numpy as np
 
     rows = {}
+    owners = per_particle(sizes.get("nprims", 0))
     for a in ENGINE:
-        if a.role == "scratch" or a.owner not in ("particle", "slot", "wall_slot"):
+        if a.role == "scratch" or a.owner not in owners:
             continue
         shp, vec = shape(a, {**sizes, "n": n})
         dt = np.int32 if a.dtype == "i32" else np.float64

@@ -33,7 +33,7 @@ from .neighbors import (F_BAD, F_FAST, F_PUSH, F_REBUILD, P_ALPHA, P_ALPHA_LOCAL
                         P_PZ0, P_SKIN, SIMP_SIZE, T_AX, T_BX, T_CX, T_DISP, T_LAW, T_MESH,
                         T_OX, T_SX, T_VX, T_WX, TRI_WIDTH, gravity, image, periodic_axes, slot_bits,
                         tri_vec)
-from . import polyhedra3d, shaped3d
+from . import polyhedra3d, primitives, shaped3d
 from .shaped import shape_of, shaped_pair, shaped_wall
 from .state import PROP_INERTIA, PROP_MASS, PROP_RADIUS
 
@@ -584,9 +584,12 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          lawp: ti.types.ndarray(), lawpair: ti.types.ndarray(), flags: ti.types.ndarray(),
          simp: ti.types.ndarray(), xforce: ti.types.ndarray(), cskip: ti.types.ndarray(),
          fext: ti.types.ndarray(), lmom: ti.types.ndarray(), ptab: ti.types.ndarray(),
-         pint: ti.types.ndarray(), bforce: ti.types.ndarray(), serial: ti.template(),
+         pint: ti.types.ndarray(), bforce: ti.types.ndarray(), prim: ti.types.ndarray(),
+         pforce: ti.types.ndarray(), ppart: ti.types.ndarray(), phist: ti.types.ndarray(),
+         pcn: ti.types.ndarray(), pcf: ti.types.ndarray(), pcs: ti.types.ndarray(),
+         serial: ti.template(),
          chunk: ti.template(), loads: ti.template(), bonds: ti.template(),
-         ranged: ti.template(), detail: ti.i32, continuum: ti.template(), laws: ti.template(),
+         ranged: ti.template(), prims: ti.template(), detail: ti.i32, continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
     """One step. ``detail`` (1 or 0) also stores what only output reads: per-contact
     normals, scalar forces and overlaps, particle forces, and the kinetic and
@@ -613,6 +616,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
 
     ``ranged`` (compile-time): a contact law of the model has a range, so that pairs of
     discs or spheres apart by less than it are evaluated too (:mod:`physics.contact_law`).
+
+    ``prims`` (compile-time, 3D): the model has primitive walls (planes, cylinders:
+    the table ``prim``, their contacts' arrays ``phist``, ``pcn``, ``pcf``, ``pcs``,
+    their forces ``pforce``, :mod:`tdem.primitives`); every sphere meets each of them.
 
     ``dim`` (compile-time): 2 (discs, superellipses, PCMM, segment walls) or 3 (spheres
     and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D.
@@ -796,6 +803,15 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wpart,
                                                      row, lawp, wid, whist, wcn, wcf, wcs, dt,
                                                      laws, ishaped, mati, shi, ranged)
+                if ti.static(prims):
+                    # (spheres only: shaped particles are refused with primitives)
+                    fp, mp, dp, wp = primitives.prim_contacts(
+                        i, vel, omega, prop, xi, prim, ppart, row, lawp, phist, pcn, pcf,
+                        pcs, dt, laws, ranged)
+                    fw += fp
+                    mw += mp
+                    dw += dp
+                    work += wp
             own = pack(f + fw, tq + mw, dim)
             if ti.static(serial or chunk):
                 facc[i] = facc[i] + own
@@ -993,6 +1009,11 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         ti.loop_config(serialize=serial)
         for w in range(nw):
             move_triangle(wall, w, dt, simp[P_SKIN], flags)
+    if ti.static(prims):
+        # the primitives' forces and motion (a few: one thread)
+        ti.loop_config(serialize=True)
+        for _ in range(1):
+            primitives.finish_step(prim, pforce, ppart, rows, dt)
     if ti.static(dim == 2):
         ti.loop_config(serialize=True)
         for w in range(nw):
