@@ -40,6 +40,7 @@ from physics.polyhedron import Polyhedron
 from .continuum import SAVED as CONTINUUM_SAVED
 from . import mesh as _mesh
 from .errors import InputError
+from .primitives import CYLINDER_IN, CYLINDER_OUT, PLANE, PR_KIND, PR_LAW, PRIM_WIDTH
 from .step import T_LAW, TRI_WIDTH, W_LAW, wall_width
 
 FORMAT = "tdem-checkpoint"
@@ -88,6 +89,8 @@ def _config(sim):
         "broad_phase": sim.broad_phase,
         "mixed_discretization": bool(sim.mixed_discretization),
         "meshes": [[int(a), int(b)] for a, b in sim._meshes],
+        # primitive walls (3D planes, cylinders): their rows now (JSON keeps the floats)
+        "primitives": [[float(x) for x in row] for row in sim._prims_host],
         "mesh_servo": [[int(m), float(k), float(f), [float(x) for x in d], float(a), float(v)]
                        for m, (k, f, d, a, v) in sorted(sim._mesh_servo.items())],
         "polyhedra": [p.input_vertices.tolist() for p in getattr(sim, "_polys", [])],
@@ -518,6 +521,17 @@ def _check(r, raw):
     wl = walls[:, W_LAW if dim == 2 else T_LAW]
     if len(walls) and (np.any(wl != np.round(wl)) or wl.min() < 0 or wl.max() >= nlaws):
         r.fail(f"'/host/walls' gives a wall the law {wl.tolist()[:8]}, outside [0, {nlaws})")
+    prims = cfg.get("primitives", [])
+    try:
+        pr = np.asarray(prims, dtype=float).reshape(len(prims), PRIM_WIDTH)
+    except (TypeError, ValueError):
+        r.fail(f"config 'primitives' must be rows of {PRIM_WIDTH} numbers, got {prims!r:.80}")
+    if len(pr) and (dim != 3 or not np.isfinite(pr).all()
+                    or not np.isin(pr[:, PR_KIND], (PLANE, CYLINDER_IN, CYLINDER_OUT)).all()
+                    or np.any(pr[:, PR_LAW] != np.round(pr[:, PR_LAW]))
+                    or pr[:, PR_LAW].min() < 0 or pr[:, PR_LAW].max() >= nlaws):
+        r.fail(f"config 'primitives' holds a row that is not a primitive wall of a 3D "
+               f"model: {pr.tolist()!r:.200}")
     if n:
         for k in ("radius", "density"):
             bad = host[k] <= 0
@@ -548,6 +562,9 @@ def _check(r, raw):
             if name not in state and schema.BY_NAME[name].owner == "bond" and \
                     not cfg.get("nbonds", 0):
                 continue                 # written before bonds, or a model without
+            if name not in state and schema.BY_NAME[name].owner.startswith("prim") and \
+                    not cfg.get("primitives"):
+                continue                 # written before primitive walls, or without
             if name not in state:
                 r.fail(f"it lacks '/state/{name}'")
             a, v = schema.BY_NAME[name], state[name]
@@ -682,6 +699,7 @@ def load(path, arch=None):
     sim._periodic = [None if p is None else tuple(p)
                      for p in cfg.get("periodic", [None] * sim.dim)]
     sim._meshes = [tuple(m) for m in cfg.get("meshes", [])]
+    sim._prims_host = [np.asarray(row, dtype=float) for row in cfg.get("primitives", [])]
     sim._mesh_servo = {m: (k, f, np.asarray(d, float), a, v)
                        for m, k, f, d, a, v in cfg.get("mesh_servo", [])}
     sim._polys = [Polyhedron(v) for v in cfg.get("polyhedra", [])]

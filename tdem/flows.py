@@ -514,7 +514,7 @@ def compact(sim, rows):
     new_index[~keep] = -1
     for name, v in list(state.items()):
         a = schema.BY_NAME.get(name)
-        if a is not None and a.owner in ("particle", "slot", "wall_slot"):
+        if a is not None and a.owner in schema.per_particle(len(sim._prims_host)):
             state[name] = v[keep]
     # the half lists: partners renumbered, the removed ones dropped (history kept)
     nbr = state["nbr"]

@@ -135,15 +135,34 @@ class Results:
         wi, wk = np.nonzero((wid >= 0) & ((wcs[:, :, 2] > 0) | (wcs[:, :, 0] != 0)))
         wu = wcs[wi, wk, 2]
         wn = a["wcn"].to_numpy()[wi, wk]
+        whist = a["whist"].to_numpy()
+        wcf_all = a["wcf"].to_numpy()
+        if self._prims_host:
+            # the primitive walls' contacts after the mesh triangles', as walls numbered
+            # on from the triangles (j = -1 - (triangles + primitive index))
+            pcs = a["pcs"].to_numpy()
+            pi_, pk = np.nonzero((pcs[:, :, 2] > 0) | (pcs[:, :, 0] != 0))
+            wid = wid.copy()
+            nw = len(self._walls_host)
+            wi = np.concatenate([wi, pi_])
+            wk = np.concatenate([wk, wid.shape[1] + pk])
+            def ext(w, p):
+                return np.concatenate([w, p], axis=1)
+            wid = ext(wid, np.broadcast_to(nw + np.arange(pcs.shape[1]),
+                                           (len(wid), pcs.shape[1])))
+            wcs = ext(wcs, pcs)
+            whist = ext(whist, a["phist"].to_numpy())
+            wcf_all = ext(wcf_all, a["pcf"].to_numpy())
+            wu = wcs[wi, wk, 2]
+            wn = np.concatenate([wn, a["pcn"].to_numpy()[pi_, pk]])
         pts = pos[ii] + self._arms(ii, normal_dir, u, r)
         wpts = pos[wi] + self._arms(wi, wn, wu, r)
-        whist = a["whist"].to_numpy()
         R = _claw.history_width(self._law_set)     # the rolling couple's column
         if d == 3:
             # (docs/api.md) the tangential force as a vector: the spring's 3 columns
             T = _claw.tangent_dim(3)
             cf = a["cf"].to_numpy()[ii, kk, :3]
-            wcf = a["wcf"].to_numpy()[wi, wk, :3]
+            wcf = wcf_all[wi, wk, :3]
             fs = np.concatenate([cf + cs[ii, kk, 0][:, None] * normal_dir,
                                  wcf + wcs[wi, wk, 0][:, None] * wn])
             extra = {}
@@ -362,6 +381,10 @@ class Results:
             e["gravitational"] = float(estate[:, 1].sum())
             e["elastic"] = float(stepk.elastic_energy_sum(*schema.bind(
                 stepk.elastic_energy_sum, a, laws=self._law_set, dim=self.dim)))
+            if self._prims_host:
+                from .primitives import elastic_energy
+                e["elastic"] += float(elastic_energy(*schema.bind(elastic_energy, a,
+                                                                  laws=self._law_set)))
             e["dissipated"] = float(eacc[:, 0].sum())
             if self._nbonds:
                 # the bonds: their springs' energy, and what the broken ones released
