@@ -290,3 +290,27 @@ def test_bad_input_is_refused_naming_the_argument():
                          density=RHO, contact=law)
     with pytest.raises(tdem.InputError, match="add_plane: primitive walls take spheres"):
         shaped.add_plane((0, 0, 0), (0, 0, 1), contact=law)
+
+
+def test_particles_added_and_removed_around_primitives():
+    """Particles added after the run started get their contact rows; an outlet that
+    removes some keeps the others' rows with them (the histories follow their rows)."""
+    sim, lid, top = _piston_box(v_lid=0.0)
+    sim.run(steps=2000)
+    law = sim._laws[0]
+    sim.add_particles([[0.03, 0.03, top + 0.05]], radius=R, density=RHO, contact=law)
+    assert sim._a["phist"].shape[:2] == (28, 6)
+    # the bottom layer's contacts with the floor, by identity, before the outlet
+    c = sim.contacts.numpy()
+    ids = sim.particles.numpy()["id"]
+    floor = {int(ids[i]): u for (i, j), u in zip(c["pairs"], c["overlap"]) if j == -1}
+    assert len(floor) >= 3
+    out = sim.remove_in(box=((0.04, -1, -1), (1, 1, 1)))
+    sim.run(steps=1)
+    assert out.count == 9 and sim.n_particles == 19
+    c = sim.contacts.numpy()
+    ids = sim.particles.numpy()["id"]
+    after = {int(ids[i]): u for (i, j), u in zip(c["pairs"], c["overlap"]) if j == -1}
+    assert set(after) == {k for k in floor if k in set(ids.tolist())}
+    for k, u in after.items():
+        assert u == pytest.approx(floor[k], rel=0.05)
