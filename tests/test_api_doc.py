@@ -6,7 +6,8 @@ Taichi kernel, so this is fast):
 
 - ``tdem.Simulation``: its constructor, and every public method and property
   (those of its base classes included);
-- the handles ``Wall``, ``Mesh``, ``Block``, ``ParticleGroup``: every public method
+- the handles ``Wall``, ``Mesh``, ``Primitive``, ``Block``, ``ParticleGroup``: every
+  public method
   and property;
 - the other classes of ``tdem.__all__`` (contact laws, materials, shapes, errors):
   the class, its constructor and its static and class methods (the alternative
@@ -45,6 +46,7 @@ ROOT = Path(__file__).resolve().parent.parent
 API = ROOT / "docs" / "api.md"
 
 HANDLES = {"Wall": ("wall", "Wall"), "Mesh": ("mesh", "Mesh"),
+           "Primitive": ("plane", "Primitive"),
            "Block": ("block", "Block"), "ParticleGroup": ("group", "ParticleGroup")}
 
 # Deliberately left out of the reference, each with the reason. Names here are not
@@ -55,9 +57,9 @@ ALLOWED = {
 }
 # Classes whose name is checked but not their constructor's parameters.
 INTERNAL_CONSTRUCTORS = {
-    # Handles are made by sim.add_wall / add_mesh / add_block / add_particles, never
-    # constructed by a script.
-    "Wall()", "Mesh()", "Block()", "ParticleGroup()",
+    # Handles are made by sim.add_wall / add_mesh / add_plane / add_cylinder /
+    # add_block / add_particles, never constructed by a script.
+    "Wall()", "Mesh()", "Primitive()", "Block()", "ParticleGroup()",
     # Errors are raised by tdem, not by scripts; api.md documents their attributes.
     "InputError()", "InstabilityError()", "CapacityError()",
 }
