@@ -18,11 +18,16 @@ Prints ``PEER tdem <threads> particle_steps_per_s <value>`` like the peers' scri
     python benchmarks/pack3d.py --cubes                # about 20,000 cubes
     python benchmarks/pack3d.py --cubes --yade         # ... and Yade's Polyhedra on them
     python benchmarks/pack3d.py --broad-phase sweep    # sort-and-sweep instead of the grid
+    python benchmarks/pack3d.py --planes               # the box as five primitive planes
     python benchmarks/pack3d.py --cubes --pour         # cubes falling: the lists rebuilt often
     python benchmarks/pack3d.py --bare                 # ... and the step written bare
     python benchmarks/pack3d.py --threads 2 --profile  # the time of each loop of the step
 
 Every run prints how many list builds its timed steps made and their time.
+
+``--planes``: the box's floor and four sides as five primitive planes
+(``sim.add_plane``, LIGGGHTS' ``wall/gran ... primitive``) instead of the mesh of 10
+triangles; the same bed, law and steps (spheres only).
 
 ``--ellipsoids``: the same number of ellipsoids of semi-axes 2, 1.6 and 1.2 mm (aspect
 1.67), their axes along x, y, z, on the lattice stretched by (1, 0.8, 0.6): the affine
@@ -198,8 +203,10 @@ def run_yade(steps, warmup, scale=1.0, bed=None):
     return "\n".join(lines) + f"\nyade warnings {warned}"
 
 
-def build(scale=1.0, arch=None, threads=None, ellipsoids=False, broad_phase="grid"):
-    """The workload; ``scale`` widens the box in x and y (the scaling runs)."""
+def build(scale=1.0, arch=None, threads=None, ellipsoids=False, broad_phase="grid",
+          planes=False):
+    """The workload; ``scale`` widens the box in x and y (the scaling runs);
+    ``planes``: the box as five primitive planes instead of a mesh."""
     import tdem
     w = 0.12 * math.sqrt(scale)
     pts = fcc(hi=(w - 0.002, w - 0.002, 0.158))
@@ -213,6 +220,13 @@ def build(scale=1.0, arch=None, threads=None, ellipsoids=False, broad_phase="gri
                           density=2500.0, contact=hm)
     else:
         sim.add_particles(pts, 0.002, density=2500.0, contact=hm)
+    if planes:
+        wy = w * stretch[1]
+        for point, normal in (((0, 0, 0), (0, 0, 1)), ((0, 0, 0), (1, 0, 0)),
+                              ((w, 0, 0), (-1, 0, 0)), ((0, 0, 0), (0, 1, 0)),
+                              ((0, wy, 0), (0, -1, 0))):
+            sim.add_plane(point, normal, contact=hm)
+        return sim
     verts, tris = tdem.surfaces.box((0.0, 0.0, 0.0), (w, w * stretch[1], 0.2))
     sim.add_mesh(verts, tris, contact=hm)
     return sim
@@ -245,9 +259,9 @@ class BuildClock:
 
 
 def measure(scale, steps, warmup, arch, threads, ellipsoids=False, cubes=False, bed=None,
-            broad_phase="grid", clock=None, profile=False):
+            broad_phase="grid", clock=None, profile=False, planes=False):
     sim = (build_cubes(arch, threads, scale, bed, broad_phase) if cubes else
-           build(scale, arch, threads, ellipsoids, broad_phase))
+           build(scale, arch, threads, ellipsoids, broad_phase, planes))
     sim.run(steps=warmup)
     if profile:
         import taichi as ti
@@ -295,8 +309,13 @@ def main(argv=None):
     p.add_argument("--profile", action="store_true",
                    help="Taichi's kernel profiler over the timed steps: the time of each "
                         "loop of the step (its rate is then lower: each loop is timed)")
+    p.add_argument("--planes", action="store_true",
+                   help="the box's floor and sides as five primitive planes (add_plane) "
+                        "instead of a mesh of 10 triangles")
     p.add_argument("--json", default=None, help="append the results to this JSON file")
     args = p.parse_args(argv)
+    if args.planes and (args.cubes or args.ellipsoids):
+        p.error("--planes: primitive walls take spheres only")
     if args.profile:
         os.environ["TDEM_PROFILE"] = "1"
     if args.scaling:
@@ -315,7 +334,7 @@ def main(argv=None):
     clock = BuildClock() if (args.arch or "cpu") == "cpu" else None
     sim, rate, el = measure(args.scale, args.steps, args.warmup, args.arch, args.threads,
                             args.ellipsoids, args.cubes, bed, args.broad_phase, clock,
-                            args.profile)
+                            args.profile, args.planes)
     if args.profile:
         import taichi as ti
         ti.profiler.print_kernel_profiler_info("count")
@@ -330,7 +349,8 @@ def main(argv=None):
         print(f"broad phase {args.broad_phase}: {clock.builds} list builds in the timed "
               f"steps, {1e3 * clock.seconds / max(clock.builds, 1):.2f} ms each, "
               f"{100 * clock.seconds / el:.1f} % of the time")
-    tag = "-ellipsoids" if args.ellipsoids else "-cubes" if args.cubes else ""
+    tag = ("-ellipsoids" if args.ellipsoids else "-cubes" if args.cubes else
+           "-planes" if args.planes else "")
     print(f"PEER tdem{tag} {args.threads} particle_steps_per_s {rate:.0f}", flush=True)
     if args.bare and not (args.cubes or args.ellipsoids):
         import bare3d
@@ -346,7 +366,7 @@ def main(argv=None):
         print(run_yade(args.steps, args.warmup, args.scale, bed), flush=True)
     if args.json:
         rec = {"particles": sim.n_particles, "threads": args.threads, "steps": args.steps,
-               "broad_phase": args.broad_phase,
+               "broad_phase": args.broad_phase, "container": "planes" if args.planes else "mesh",
                "seconds": el, "particle_steps_per_s": rate, "arch": args.arch or "cpu"}
         data = json.load(open(args.json)) if os.path.exists(args.json) else []
         data.append(rec)
