@@ -562,7 +562,7 @@ def _check(r, raw):
             if name not in state and schema.BY_NAME[name].owner == "bond" and \
                     not cfg.get("nbonds", 0):
                 continue                 # written before bonds, or a model without
-            if name not in state and schema.BY_NAME[name].owner.startswith("prim") and \
+            if name not in state and name in schema.PRIM_ARRAYS and \
                     not cfg.get("primitives"):
                 continue                 # written before primitive walls, or without
             if name not in state:

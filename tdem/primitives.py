@@ -130,15 +130,6 @@ def geometry(prim: ti.template(), p, xi):
 
 
 @ti.func
-def _spring2(h, T: ti.template()):
-    """|first T columns|² of a history (the shear spring): zero for a fresh contact."""
-    e = 0.0
-    for c in ti.static(range(T)):
-        e += h[c] * h[c]
-    return e
-
-
-@ti.func
 def prim_contacts(i, vel: ti.template(), omega: ti.template(), prop: ti.template(), xi,
                   prim: ti.template(), ppart: ti.template(), row, lawp: ti.template(),
                   phist: ti.template(), pcn: ti.template(), pcf: ti.template(),
@@ -162,8 +153,8 @@ def prim_contacts(i, vel: ti.template(), omega: ti.template(), prop: ti.template
         reach = 0.0
         if ti.static(ranged):
             reach = lawp[L, COL_REACH]
-        h = phist[i, p]
         if depth > -reach:
+            h = phist[i, p]
             point = xi + (ri - 0.5 * depth) * n
             arm = point - xi
             vw = _col3(prim, p, PR_VX)
@@ -206,11 +197,18 @@ def prim_contacts(i, vel: ti.template(), omega: ti.template(), prop: ti.template
                 ti.atomic_add(ppart[row, p][k], -f[k])
                 ti.atomic_add(ppart[row, p][3 + k], tw[k])
             ti.atomic_add(ppart[row, p][6], 1.0)
-        elif (_spring2(h, T) != 0.0 or pcs[i, p][2] > 0.0
-              or (ranged and h.dot(h) != 0.0)):
-            phist[i, p] = zero_history(h)
-            pcf[i, p] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-            pcs[i, p] = ti.Vector([0.0, 0.0, ti.min(depth, 0.0)])
+        else:
+            # a contact that has just ended (it touched in the last step: the history
+            # is read only then, not for every particle and primitive apart)
+            ended = pcs[i, p][2] > 0.0
+            if ti.static(ranged):
+                if not ended:
+                    h = phist[i, p]
+                    ended = h.dot(h) != 0.0
+            if ended:
+                phist[i, p] = zero_history(phist[i, p])
+                pcf[i, p] = ti.Vector([0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+                pcs[i, p] = ti.Vector([0.0, 0.0, ti.min(depth, 0.0)])
     return ftot, mtot, diss, work
 
 

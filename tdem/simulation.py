@@ -937,7 +937,8 @@ class Simulation(Runner, Results):
         if self.dim != 3:
             raise InputError(f"{what} is 3D: use tdem.Simulation(dim=3); a 2D simulation "
                              "takes segment walls (add_wall)")
-        if self._n and self._has_shapes:
+        if (self._n and self._has_shapes) or any(ins.shape is not None
+                                                 for ins in self._inserters):
             raise InputError(f"{what}: primitive walls take spheres only; this model has "
                              "shaped particles (ellipsoids or polyhedra): use a mesh wall "
                              "(add_mesh with tdem.surfaces.plane)")
@@ -997,6 +998,9 @@ class Simulation(Runner, Results):
         ``stop()``). Models with PCMM bodies or blocks take none."""
         from .flows import Inserter, Region
         self._refuse_flows("insert")
+        if shape is not None and self.dim == 3 and self._prims_host:
+            raise InputError(f"shape: primitive walls (add_plane, add_cylinder) take "
+                             f"spheres only; got shape={shape!r}")
         region = Region(self.dim, box=box, sphere=sphere, polygon=polygon)
         ins = Inserter(self, region, rate=rate, count=count, per_s=per_s, radius=radius,
                        grading=grading, density=density, contact=contact, velocity=velocity,

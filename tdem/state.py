@@ -174,6 +174,9 @@ ENGINE = (
           doc="bounding box of the particles (lower, upper corner), largest radius"),
 )
 BY_NAME = {a.name: a for a in ENGINE}
+# the primitive walls' arrays (a checkpoint of a model without them may lack them)
+PRIM_ARRAYS = frozenset(a.name for a in ENGINE if a.owner.startswith("prim")
+                        or a.name == "prim")
 
 
 def per_particle(nprims):

@@ -91,12 +91,15 @@ def _drop(primitive, normal, velocity, omega, law, steps=3000, segments=6):
     return np.array(out), sim
 
 
-@pytest.mark.parametrize("normal, velocity, omega", [
-    ((0, 0, 1), (0.0, 0.0, -0.5), (0.0, 0.0, 0.0)),
-    ((0.3, -0.2, 1.0), (0.8, -0.3, -0.6), (20.0, -5.0, 3.0)),
+@pytest.mark.parametrize("normal, velocity, omega, rolling", [
+    ((0, 0, 1), (0.0, 0.0, -0.5), (0.0, 0.0, 0.0), False),
+    ((0.3, -0.2, 1.0), (0.8, -0.3, -0.6), (20.0, -5.0, 3.0), False),
+    ((0.3, -0.2, 1.0), (0.8, -0.3, -0.6), (20.0, -5.0, 3.0), True),
 ])
-def test_drop_equals_the_drop_on_a_meshed_plane(normal, velocity, omega):
-    law = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.3, restitution=0.5)
+def test_drop_equals_the_drop_on_a_meshed_plane(normal, velocity, omega, rolling):
+    """The last case with rolling resistance (the couple's columns of the history)."""
+    law = tdem.HertzMindlin(young=1e7, poisson=0.3, friction=0.3, restitution=0.5,
+                            rolling=tdem.RollingResistance(0.4) if rolling else None)
     a, sim = _drop(True, normal, velocity, omega, law)
     b, _ = _drop(False, normal, velocity, omega, law)
     # the sphere met the plane: it came off it (and fell back) or rests on it
@@ -314,3 +317,44 @@ def test_particles_added_and_removed_around_primitives():
     assert set(after) == {k for k in floor if k in set(ids.tolist())}
     for k, u in after.items():
         assert u == pytest.approx(floor[k], rel=0.05)
+
+
+_PISTON = """
+import numpy as np, sys
+sys.path.insert(0, {root!r})
+sys.path.insert(0, {tests!r})
+import tdem
+from test_primitive_walls import _piston_box
+sim, lid, top = _piston_box()
+sim.run(steps=6000)
+f = np.array([p.force for p in sim.primitives])
+np.save(sys.argv[1], np.concatenate([sim.particles.numpy()["position"], f]))
+print("chunk", tdem.backend.chunk_size(sim.n_particles, sim._serial()))
+"""
+
+
+def test_one_thread_and_parallel_paths_agree(tmp_path):
+    """The primitives' forces summed over the chunks of the step's pair loop (two
+    threads, 8 chunks) and with every pair through its slot (the GPU's path, run on
+    the CPU) agree with one thread to round-off, and repeat bit for bit."""
+    import os
+    import subprocess
+    import sys
+    here = os.path.dirname(os.path.abspath(__file__))
+    script = tmp_path / "piston.py"
+    script.write_text(_PISTON.format(root=os.path.dirname(here), tests=here))
+    out, chunk = {}, {}
+    for name, threads, chunks in (("one", "1", ""), ("chunks", "2", "8"),
+                                  ("chunks again", "2", "8"), ("slots", "2", "0")):
+        path = tmp_path / f"{name}.npy"
+        run = subprocess.run([sys.executable, str(script), str(path)],
+                             env=dict(os.environ, TDEM_THREADS=threads, TDEM_SERIAL_BELOW="0",
+                                      TDEM_CHUNKS=chunks),
+                             check=True, capture_output=True, text=True)
+        out[name] = np.load(path)
+        chunk[name] = int(run.stdout.split("chunk")[-1])
+    assert chunk == {"one": 0, "chunks": 4, "chunks again": 4, "slots": 0}
+    scale = np.abs(out["one"]).max(axis=0)
+    for name in ("chunks", "slots"):
+        assert np.all(np.abs(out[name] - out["one"]) <= 1e-9 * scale), name
+    assert np.array_equal(out["chunks"], out["chunks again"])
