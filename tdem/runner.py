@@ -309,7 +309,9 @@ class Runner:
         self._law_set = _claw.registered()
         tdim = _claw.tangent_dim(self.dim)
         for k, width in (("hist", _claw.pair_history_width(self._law_set, tdim)),
-                         ("whist", _claw.wall_history_width(self._law_set, tdim))):
+                         ("whist", _claw.wall_history_width(self._law_set, tdim)),
+                         # the primitive walls' contacts keep a wall contact's history
+                         ("phist", _claw.wall_history_width(self._law_set, tdim))):
             if k in state and self.dim == 3:
                 # 3D: the law's columns kept, an ellipsoid tail (tdem.shaped3d) zeroed
                 # when the width changes (the warm starts are found again)

@@ -358,3 +358,28 @@ def test_one_thread_and_parallel_paths_agree(tmp_path):
     for name in ("chunks", "slots"):
         assert np.all(np.abs(out[name] - out["one"]) <= 1e-9 * scale), name
     assert np.array_equal(out["chunks"], out["chunks again"])
+
+
+def test_a_plane_added_after_a_run_and_a_rolling_law_after_it():
+    """A sphere falling in a model without primitives; a floor plane added between runs
+    catches it (the step compiled with them from then on); a second sphere with a law
+    of rolling resistance added later widens the histories, and the first keeps its
+    contact."""
+    kn = 1e4
+    law = tdem.LinearContact(kn=kn, friction=0.5, restitution=0.3)
+    sim = tdem.Simulation(dim=3, gravity=(0, 0, -G), dt=1e-5, local_damping=0.5,
+                          progress=False)
+    sim.add_particles([[0.0, 0.0, 0.05]], radius=R, density=RHO, contact=law)
+    sim.run(steps=1000)
+    assert sim.particles.numpy()["position"][0, 2] < 0.05
+    floor = sim.add_plane((0, 0, 0), (0, 0, 1), contact=law)
+    sim.run(steps=30000)
+    assert R - sim.particles.numpy()["position"][0, 2] == pytest.approx(MASS * G / kn,
+                                                                      rel=1e-6)
+    rolling = tdem.LinearContact(kn=kn, friction=0.5, restitution=0.3,
+                                 rolling=tdem.RollingResistance(0.3))
+    sim.add_particles([[0.1, 0.0, R]], radius=R, density=RHO, contact=rolling)
+    sim.run(steps=20000)
+    z = sim.particles.numpy()["position"][:, 2]
+    np.testing.assert_allclose(R - z, MASS * G / kn, rtol=1e-6)
+    np.testing.assert_allclose(floor.force, [0, 0, -2 * MASS * G], rtol=1e-6, atol=1e-12)
