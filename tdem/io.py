@@ -215,22 +215,87 @@ def _write_spheres_vtu(path, p, shape):
 
 
 def write_meshes_vtu(sim, path):
-    """3D: the mesh walls to ``path``, one ``triangle`` cell per triangle. Cell data:
-    ``mesh`` (its index), ``force`` (N, received by the triangle in the last step),
-    ``velocity`` (m/s, translation)."""
+    """3D: the mesh walls and the primitive walls to ``path``, one ``triangle`` cell
+    per triangle. Cell data: ``mesh`` (its index; −1 on a primitive), ``primitive``
+    (its index; −1 on a mesh triangle), ``force`` (N, received by the triangle in the
+    last step), ``velocity`` (m/s, translation).
+
+    A primitive is infinite; it is drawn as a patch around the particles: a plane as a
+    square of 2·PRIMITIVE_DIVISIONS² cells centred on the particles' bounding box's
+    centre projected onto it, as wide as the box's diagonal plus twice a margin; a
+    cylinder as PRIMITIVE_SEGMENTS facets around its axis over the particles' extent
+    along it plus the margin (the margin: a tenth of the diagonal, at least the
+    largest radius). Its cells share its total force evenly, so that the force summed
+    over a wall's cells is the force on it, for meshes and primitives alike."""
     from .step import T_AX, T_BX, T_CX, T_MESH, T_VX, TRI_WIDTH
     tri = np.asarray(sim._wall_rows(), dtype=np.float64).reshape(-1, TRI_WIDTH)
     pts = np.stack([tri[:, T_AX:T_AX + 3], tri[:, T_BX:T_BX + 3], tri[:, T_CX:T_CX + 3]],
                    axis=1).reshape(-1, 3)
     loads = np.asarray(sim._wall_loads(), dtype=np.float64).reshape(-1, 7)
+    pts, mesh, prim = [pts], [tri[:, T_MESH].astype(np.int64)], [np.full(len(tri), -1)]
+    force, velocity = [loads[:, :3].copy()], [tri[:, T_VX:T_VX + 3].copy()]
+    for k, w in enumerate(getattr(sim, "primitives", [])):
+        t = _primitive_patch(sim, w)
+        m = len(t)
+        pts.append(t.reshape(-1, 3))
+        mesh.append(np.full(m, -1))
+        prim.append(np.full(m, k))
+        force.append(np.tile(w.force / m, (m, 1)))
+        velocity.append(np.tile(w.velocity, (m, 1)))
+    pts = np.concatenate(pts)
     cell_data = {
-        "mesh": [tri[:, T_MESH].astype(np.int64)],
-        "force": [loads[:, :3].copy()],
-        "velocity": [tri[:, T_VX:T_VX + 3].copy()],
+        "mesh": [np.concatenate(mesh).astype(np.int64)],
+        "primitive": [np.concatenate(prim).astype(np.int64)],
+        "force": [np.concatenate(force)],
+        "velocity": [np.concatenate(velocity)],
     }
     _write_mesh(path, pts, [("triangle", np.arange(len(pts), dtype=np.int64).reshape(-1, 3))],
                 cell_data=cell_data)
     return path
+
+
+PRIMITIVE_DIVISIONS = 8    # a plane's patch: divisions × divisions squares, two cells each
+PRIMITIVE_SEGMENTS = 48    # a cylinder's patch: facets around the axis
+
+
+def _primitive_patch(sim, w):
+    """Triangles (m, 3, 3) drawing primitive wall ``w`` around the particles."""
+    x, r = np.zeros((0, 3)), np.zeros(0)
+    if sim.n_particles:
+        pa = sim.particles.numpy(stress=False)
+        x = np.asarray(pa["position"], dtype=np.float64)
+        r = np.asarray(pa["radius"], dtype=np.float64)
+    p, a = np.asarray(w.point, dtype=np.float64), np.asarray(w.normal, dtype=np.float64)
+    if len(x):
+        lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
+        diag = float(np.linalg.norm(hi - lo))
+        margin = max(0.1 * diag, float(r.max()))
+        centre = 0.5 * (lo + hi)
+    else:
+        diag, margin, centre = 0.0, max(1.0, 2.0 * w.radius), p
+    # two unit vectors across a
+    e = np.eye(3)[int(np.argmin(np.abs(a)))]
+    u = np.cross(a, e)
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    if w.kind == "plane":
+        c = centre - np.dot(centre - p, a) * a
+        half = 0.5 * diag + margin
+        s = np.linspace(-half, half, PRIMITIVE_DIVISIONS + 1)
+        g = c + s[:, None, None] * u + s[None, :, None] * v      # (d+1, d+1, 3)
+        q00, q10, q01, q11 = g[:-1, :-1], g[1:, :-1], g[:-1, 1:], g[1:, 1:]
+        t = np.concatenate([np.stack([q00, q10, q11], axis=2).reshape(-1, 3, 3),
+                            np.stack([q00, q11, q01], axis=2).reshape(-1, 3, 3)])
+        return t
+    along = (x - p) @ a if len(x) else np.zeros(1)
+    rr = r if len(x) else np.zeros(1)
+    z0, z1 = float((along - rr).min()) - margin, float((along + rr).max()) + margin
+    phi = np.linspace(0.0, 2.0 * np.pi, PRIMITIVE_SEGMENTS + 1)
+    ring = w.radius * (np.cos(phi)[:, None] * u + np.sin(phi)[:, None] * v)
+    b, top = p + z0 * a + ring, p + z1 * a + ring
+    t = np.concatenate([np.stack([b[:-1], b[1:], top[1:]], axis=1),
+                        np.stack([b[:-1], top[1:], top[:-1]], axis=1)])
+    return t
 
 
 SHAPE_OUTLINE = 48    # boundary points of a shaped particle's polygon in the VTU file

@@ -383,3 +383,37 @@ def test_a_plane_added_after_a_run_and_a_rolling_law_after_it():
     z = sim.particles.numpy()["position"][:, 2]
     np.testing.assert_allclose(R - z, MASS * G / kn, rtol=1e-6)
     np.testing.assert_allclose(floor.force, [0, 0, -2 * MASS * G], rtol=1e-6, atol=1e-12)
+
+
+def test_primitives_are_drawn_in_the_walls_file(tmp_path):
+    """ParaView sees the primitives: the walls file holds a plane's patch on the plane
+    and a cylinder's facets' corners on its radius, around the particles, and each
+    wall's cells add up to the force on it."""
+    import meshio
+
+    law = tdem.LinearContact(kn=1e4, friction=0.5, restitution=0.3)
+    sim = tdem.Simulation(dim=3, gravity=(0, 0, -G), dt=1e-5, progress=False)
+    xs = [[0.02 * i - 0.03, 0.0, 0.0099] for i in range(4)]
+    sim.add_particles(xs, radius=R, density=RHO, contact=law)
+    floor = sim.add_plane((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), contact=law)
+    drum = sim.add_cylinder((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), 0.1, contact=law)
+    sim.run(steps=200)
+    from tdem.io import write_vtu
+    paths = write_vtu(sim, tmp_path / "snap.vtu")
+    walls = meshio.read([q for q in paths if q.endswith("_walls.vtu")][0])
+    tri = walls.cells_dict["triangle"]
+    prim = walls.cell_data_dict["primitive"]["triangle"]
+    force = walls.cell_data_dict["force"]["triangle"]
+    pts = walls.points
+    on_plane = pts[tri[prim == 0]].reshape(-1, 3)
+    assert np.abs(on_plane[:, 2]).max() < 1e-12
+    # the patch reaches past the particles on every side
+    assert on_plane[:, 0].min() < -0.04 and on_plane[:, 0].max() > 0.04
+    on_drum = pts[tri[prim == 1]].reshape(-1, 3)
+    assert np.hypot(on_drum[:, 0], on_drum[:, 1]) == pytest.approx(0.1, rel=1e-12)
+    assert on_drum[:, 2].min() < 0.0 < 0.022 < on_drum[:, 2].max()
+    np.testing.assert_allclose(force[prim == 0].sum(axis=0), floor.force, rtol=1e-12,
+                               atol=1e-15)
+    np.testing.assert_allclose(force[prim == 1].sum(axis=0), drum.force, atol=1e-15)
+    assert abs(floor.force[2]) > 0.1      # the spheres touch the floor: a real sum
+    assert (walls.cell_data_dict["mesh"]["triangle"][prim >= 0] == -1).all()
