@@ -2,24 +2,26 @@
 (cases/bearing_capacity.py): many elements flowing plastically together.
 
 A rigid block pushed at 0.01 m/s through frictionless point–edge contacts into a
-Mohr–Coulomb soil (c = 10 kPa, E = 10 MPa, ν = 0.3), the half-model right of the
-centre line; q/c is the mean over a settlement of 0.08–0.10 b. Limit analysis:
-N_c = 2 + π (φ = 0), (N_q − 1)·cot φ = 14.83 (φ = ψ = 20°). The discretisation
-converges towards N_c from above, as h/b (docs/pcmm.md has the table over three
-resolutions, packings and meshes); the tolerances below follow that table:
+Mohr–Coulomb soil (c = 10 kPa, E = 100 MPa, ν = 0.3), the half-model right of the
+centre line; q/c is the mean over a settlement of 0.008–0.010 b past the seating
+(Prandtl's is a small-displacement load: the case's docstring says why the settlement
+is small). Limit analysis: N_c = 2 + π (φ = 0), (N_q − 1)·cot φ = 14.83 (φ = ψ = 20°).
+docs/pcmm.md has the table over three resolutions, packings and meshes; the
+tolerances below follow it:
 
-- PCMM square lattice, 6 spacings under the half-footing: q/c within −3 % / +12 %
-  of 2 + π (measured +8.8 %); with each element's own volumetric strain (no mixed
+- PCMM square lattice, 6 spacings under the half-footing: q/c within 5 % of 2 + π
+  (measured +1.1 %); with each element's own volumetric strain (no mixed
   discretization) the soil locks: more than 1.2 × N_c at 4 spacings (measured
-  1.74 × N_c; 1.31 × N_c at 10);
+  1.66 × N_c; 1.27 × N_c at 10);
 - slow (``pytest -m slow``): φ = ψ = 20° on the PCMM square lattice, 10 spacings
-  under the half-footing, within 10 % of 14.83 (measured +2.7 %; the FVM mesh of
-  one diagonal per cell reads +15 % there, +23 % at 6 cells); the finest
-  resolution, 20 per half-width, within 5 % of 2 + π on the FVM mesh (measured
-  +3.9 %) and on the PCMM square lattice (+3.5 %).
+  under the half-footing, within 10 % of 14.83; the finest resolution, 20 per
+  half-width, within 5 % of 2 + π on the FVM meshes of one and of crossed diagonals
+  (measured +0.6 % and +0.3 %) and on the PCMM square and hexagonal lattices (+2.2 %
+  and −0.3 %).
 """
 import math
 
+import numpy as np
 import pytest
 
 from cases import bearing_capacity as bc
@@ -35,12 +37,27 @@ def test_prandtl_factors():
 
 def test_pcmm_tresca_soil_collapses_at_prandtl_load():
     r = bc.footing("regular", 6)
-    assert 0.97 * NC0 < r["limit"] < 1.12 * NC0, r["limit"]
+    assert r["limit"] == pytest.approx(NC0, rel=0.05)
+    assert abs(r["rise"]) < bc.FLAT_TOL
 
 
 def test_pcmm_soil_without_mixed_discretization_locks():
     r = bc.footing("regular", 4, mixed=False)
     assert r["limit"] > 1.2 * NC0, r["limit"]
+
+
+def test_load_rises_with_settlement_on_the_updated_geometry():
+    """Why the read-out is at a small settlement: the continuum's strains and forces
+    are taken on its current geometry, and a footing that travels far is resisted by
+    more than Prandtl's small-displacement load (crossed FVM mesh, 5 cells under the
+    half-footing, E/c = 1000 as the case first ran: q/c = 5.16 at s = 0.04 b, 5.75 at
+    0.2 b, +11 %), while the case's read-out at 0.008–0.010 b reads 2 + π within 2 %
+    (measured −1.6 %)."""
+    r = bc.footing("fvm_cross", 5, young=10e6, s_end=0.2)
+    q = lambda s: float(np.interp(s, r["s_over_b"], r["q_over_c"]))  # noqa: E731
+    assert q(0.04) == pytest.approx(NC0, rel=0.02)
+    assert q(0.2) / q(0.04) - 1.0 > 0.08
+    assert bc.footing("fvm_cross", 5)["limit"] == pytest.approx(NC0, rel=0.02)
 
 
 @pytest.mark.slow
@@ -50,11 +67,11 @@ def test_pcmm_frictional_soil_collapses_at_prandtl_load():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kind", ["fvm", "regular"])
+@pytest.mark.parametrize("kind", ["fvm", "fvm_cross", "regular", "cross"])
 def test_finest_resolution_within_five_percent(kind):
     r = bc.footing(kind, 20)
     assert r["limit"] == pytest.approx(NC0, rel=0.05)
-    assert r["limit"] > 0.97 * NC0
+    assert abs(r["rise"]) < bc.FLAT_TOL
 
 
 @pytest.mark.parametrize("kw,word", [({"models": ["hexagon"]}, "models"),
