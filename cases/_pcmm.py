@@ -11,9 +11,9 @@ A model is described by a small dict ``spec``:
   ``inset`` None puts the outermost centres R from the edges, 0 puts them on the
   edges; cross ``fit`` True shrinks the spacings so that the rows end on the edges);
 - ``{"kind": "random", "rmin": .., "rmax": .., "tolerance": δ, "fraction": 0.8,
-  "overlap_tol": 1e-3, "edge_centres": False, "fill_holes": False, "seed": 0}``
-  (``tdem.pack.random``; ``edge_centres`` True puts the boundary discs' centres on
-  the edges; a fraction above jamming needs a larger ``overlap_tol``;
+  "overlap_tol": 1e-3, "edge_centres": False, "edge_radius": None, "fill_holes": False,
+  "seed": 0}`` (``tdem.pack.random``; ``edge_centres`` True puts the boundary discs'
+  centres on the edges, ``edge_radius`` gives them one radius; a fraction above jamming needs a larger ``overlap_tol``;
   ``fill_holes`` True adds discs into the holes of the element cover of δ,
   ``pcmm_tolerance``);
 - ``{"kind": "fvm", "cells": (nx, ny), "pattern": "regular" | "cross"}``
@@ -89,6 +89,7 @@ class Model:
                                                   seed=spec.get("seed", 0),
                                                   target_fraction=frac, origin=origin,
                                                   edge_centres=spec.get("edge_centres", False),
+                                                  edge_radius=spec.get("edge_radius"),
                                                   overlap_tol=spec.get("overlap_tol", 1e-3),
                                                   pcmm_tolerance=spec["tolerance"] if spec.get(
                                                       "fill_holes", False) else None)

@@ -235,7 +235,7 @@ def _pairs(x, cut, h):
 
 def random(width, height, rmin=None, rmax=None, seed=0, target_fraction=0.8,
            origin=(0.0, 0.0), polygon=None, overlap_tol=1e-3, max_iter=20000,
-           edge_centres=False, pcmm_tolerance=None, grading=None):
+           edge_centres=False, pcmm_tolerance=None, grading=None, edge_radius=None):
     """Dense random packing of discs with radii uniform in [rmin, rmax], or drawn
     from ``grading`` (a :func:`tdem.grading`: its mass curve for discs of equal
     thickness; rmin and rmax are then its range and are left out).
@@ -277,7 +277,11 @@ def random(width, height, rmin=None, rmax=None, seed=0, target_fraction=0.8,
     first); the others are packed inside the region as above and kept clear of
     them. The area fraction then counts the part of each boundary disc inside the
     region (half a disc on an edge, the corner's angle on a vertex). Default off:
-    the packing and its random stream are unchanged.
+    the packing and its random stream are unchanged. ``edge_radius`` (m, with
+    ``edge_centres``) gives the boundary discs that one radius instead of drawn ones,
+    so that the packing's sides are flush: the tops of the discs along its top edge
+    lie on one line (a footing set on it touches them all at once; drawn radii leave
+    a relief of rmax − rmin).
 
     ``pcmm_tolerance=δ`` (the Eq. 1 tolerance of the PCMM material the discs are
     for) then fills the holes that the PCMM element cover of that δ leaves
@@ -301,8 +305,13 @@ def random(width, height, rmin=None, rmax=None, seed=0, target_fraction=0.8,
                          f"for discs of rmax={rmax!r}")
     rng = np.random.default_rng(seed)
 
+    if edge_radius is not None:
+        edge_radius = _positive("edge_radius", edge_radius)
+        if not edge_centres:
+            raise InputError(f"edge_radius={edge_radius!r} needs edge_centres=True (it is "
+                             "the radius of the discs centred on the boundary)")
     if edge_centres:
-        xb, rb, inside_area = _edge_discs(poly, rmin, rmax, rng)
+        xb, rb, inside_area = _edge_discs(poly, rmin, rmax, rng, edge_radius)
     else:
         xb, rb, inside_area = np.zeros((0, 2)), np.zeros(0), 0.0
     nb = len(xb)
@@ -589,13 +598,19 @@ def _in_rows(x, r, nb):
     return x[keep], r[keep]
 
 
-def _edge_discs(poly, rmin, rmax, rng):
+def _edge_discs(poly, rmin, rmax, rng, radius=None):
     """Discs centred on the boundary of ``poly``: one on each vertex, and along each
     edge as many as fit in a row of touching discs between the two vertex discs,
-    spread evenly to the edge's length. Returns (centres, radii, the discs' area
-    inside the polygon)."""
+    spread evenly to the edge's length; radii drawn from [rmin, rmax], or all
+    ``radius``. Returns (centres, radii, the discs' area inside the polygon)."""
     m = len(poly)
-    rv = rng.uniform(rmin, rmax, m)
+
+    def draw(k=None):
+        if radius is not None:
+            return float(radius) if k is None else np.full(k, float(radius))
+        return rng.uniform(rmin, rmax) if k is None else rng.uniform(rmin, rmax, k)
+
+    rv = draw(m)
     xs, rs = [], []
     inside = 0.0
     for k in range(m):
@@ -611,7 +626,7 @@ def _edge_discs(poly, rmin, rmax, rng):
         ri = []
         span = rv[k] + r_end
         while True:
-            new = rng.uniform(rmin, rmax)
+            new = draw()
             if span + 2 * new > length:
                 break
             ri.append(new)

@@ -200,6 +200,31 @@ def test_random_edge_centres():
     np.testing.assert_array_equal(x, x2)
 
 
+def test_random_edge_radius_makes_the_sides_flush():
+    """edge_radius: every boundary disc of that one radius, so the top row's tops lie
+    on one line (drawn radii leave a relief up to rmax − rmin), the inner discs still
+    drawn from the range, the boundary's discs touching or nearly (as with drawn radii);
+    without edge_centres it is refused, naming it."""
+    W, H, rm = 20.0, 10.0, 0.48
+    x, r = pack.random(W, H, 0.336, 0.624, seed=3, edge_centres=True, edge_radius=rm)
+    on = (np.isclose(x[:, 0], 0.0) | np.isclose(x[:, 0], W)
+          | np.isclose(x[:, 1], 0.0) | np.isclose(x[:, 1], H))
+    nb = int(on.sum())
+    assert nb > 0 and np.all(on[:nb]) and np.all(r[:nb] == rm)
+    top = np.isclose(x[:nb, 1], H)
+    assert np.ptp(x[:nb][top, 1] + r[:nb][top]) == 0.0
+    assert np.all((r[nb:] >= 0.336) & (r[nb:] <= 0.624)) and np.ptp(r[nb:]) > 0.2
+    d = np.diff(np.sort(x[:nb][top, 0]))
+    assert d.max() <= 2 * rm + 2 * rm / top.sum() + 1e-12 and d.min() >= 2 * rm - 1e-12
+    assert _min_gap(x, r) >= -1e-3 * 0.336
+    _, r_drawn = pack.random(W, H, 0.336, 0.624, seed=3, edge_centres=True)
+    assert np.ptp(r_drawn[:nb]) > 0.2
+    with pytest.raises(tdem.InputError, match="edge_radius"):
+        pack.random(W, H, 0.336, 0.624, edge_radius=rm)
+    with pytest.raises(tdem.InputError, match="edge_radius"):
+        pack.random(W, H, 0.336, 0.624, edge_centres=True, edge_radius=-1.0)
+
+
 def _element_union(x, r, tol):
     from test_pcmm_elements import union_area
     from physics.pcmm import ElementSystem
