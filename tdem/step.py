@@ -589,7 +589,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          pcn: ti.types.ndarray(), pcf: ti.types.ndarray(), pcs: ti.types.ndarray(),
          serial: ti.template(),
          chunk: ti.template(), loads: ti.template(), bonds: ti.template(),
-         ranged: ti.template(), prims: ti.template(), detail: ti.i32, continuum: ti.template(), laws: ti.template(),
+         ranged: ti.template(), prims: ti.template(), periodic: ti.template(), detail: ti.i32, continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
     """One step. ``detail`` (1 or 0) also stores what only output reads: per-contact
     normals, scalar forces and overlaps, particle forces, and the kinetic and
@@ -621,6 +621,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     the table ``prim``, their contacts' arrays ``phist``, ``pcn``, ``pcf``, ``pcs``,
     their forces ``pforce``, :mod:`tdem.primitives`); every sphere meets each of them.
 
+    ``periodic`` (compile-time): the model has a periodic axis (pairs are then taken at
+    their nearest images and positions wrapped, simp[P_PX0 ...]); without one the
+    checks compile away.
+
     ``dim`` (compile-time): 2 (discs, superellipses, PCMM, segment walls) or 3 (spheres
     and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D.
 
@@ -637,7 +641,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     alpha_l = simp[P_ALPHA_LOCAL]
     damped = alpha != 0.0 or alpha_l != 0.0
     half_skin2 = (0.5 * simp[P_SKIN]) ** 2
-    per = periodic_axes(simp, dim)
+    per = ti.Vector([0.0] * (2 * dim))      # (no periodic axis: the checks compile away)
+    if ti.static(periodic):
+        per = periodic_axes(simp, dim)
 
     if ti.static(shapes and dim == 2):
         # each angle's cosine and sine once, for all the pairs it takes part in
