@@ -1,6 +1,7 @@
 """One time step of the DEM: the whole data flow in one kernel.
 
-    forces at x_n (pair contacts from the neighbour lists, wall contacts),
+    forces at x_n (3D: wall contacts first, in a loop of their own, kept per
+      particle in wacc; pair contacts from the neighbour lists; 2D wall contacts),
       summed per owner particle; the partner's share goes straight to its sum on
       one thread and within a CPU thread's chunk of particles, or stays in the
       pair's slot across chunks and on a GPU
