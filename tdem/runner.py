@@ -636,7 +636,8 @@ class Runner:
         return schema.bind(stepk.step, self._a, xforce=self._xforce(), serial=self._serial(),
                            chunk=self._chunk() > 0, loads=bool(self._loads_on),
                            bonds=self._nbonds > 0, ranged=self._law_range > 0.0,
-                           prims=bool(self._prims_host), detail=False,
+                           prims=bool(self._prims_host),
+                           periodic=any(p is not None for p in self._periodic), detail=False,
                            continuum=False, laws=self._law_set, shapes=False,
                            dim=self.dim)[:-5]
 

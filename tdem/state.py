@@ -76,6 +76,9 @@ ENGINE = (
     Array("pos0", "particle", "D", "f", "dynamic",
           doc="position at the start (displacement; shifted with a periodic wrap)"),
     Array("facc", "particle", "DS", "f", "scratch", doc="force and moment sums of a step"),
+    Array("wacc", "particle", {2: 5, 3: 8}, "f", "scratch",
+          doc="3D: a particle's wall contacts of a step (force, moment, dissipation, work "
+              "of the walls), from the step's wall loop to its pair loop"),
     Array("turn", "particle", {2: 2, 3: 9}, "f", "scratch",
           doc="cos θ, sin θ of each particle's angle at the step's start (2D); in 3D "
               "each particle's shape matrix, row by row (models with ellipsoids)"),

@@ -1,6 +1,7 @@
 """One time step of the DEM: the whole data flow in one kernel.
 
-    forces at x_n (pair contacts from the neighbour lists, wall contacts),
+    forces at x_n (3D: wall contacts first, in a loop of their own, kept per
+      particle in wacc; pair contacts from the neighbour lists; 2D wall contacts),
       summed per owner particle; the partner's share goes straight to its sum on
       one thread and within a CPU thread's chunk of particles, or stays in the
       pair's slot across chunks and on a GPU
@@ -566,6 +567,57 @@ def servo_velocity(wall: ti.template(), wforce: ti.template(), w, dt):
     return v * d[0], v * d[1]
 
 
+@ti.func
+def walls_3d(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
+             prop: ti.template(), angle: ti.template(), turn: ti.template(), shp: ti.template(),
+             wall: ti.template(), wpart: ti.template(), row, lawp: ti.template(),
+             wid: ti.template(), whist: ti.template(), wcn: ti.template(), wcf: ti.template(),
+             wcs: ti.template(), flags: ti.template(), dt, laws: ti.template(),
+             ptab: ti.template(), pint: ti.template(), prim: ti.template(),
+             ppart: ti.template(), phist: ti.template(), pcn: ti.template(),
+             pcf: ti.template(), pcs: ti.template(), ranged: ti.template(),
+             prims: ti.template(), shapes: ti.template()):
+    """3D: particle i's contacts with its candidate mesh triangles (a polyhedron's by
+    :func:`tdem.polyhedra3d.mesh_contacts`, a sphere's or an ellipsoid's by
+    :func:`mesh_contacts`) and with the primitive walls. Returns (force, moment,
+    dissipation, work of the walls)."""
+    xi = pos[i]
+    ri = prop[i][PROP_RADIUS]
+    fw = ti.Vector([0.0, 0.0, 0.0])
+    mw = ti.Vector([0.0, 0.0, 0.0])
+    dw = 0.0
+    work = 0.0
+    shi = ti.Vector([0.0, 0.0, 0.0])
+    ishaped = False
+    mati = ti.Matrix.identity(float, 3)
+    if ti.static(shapes & SHAPES_SMOOTH):
+        shi = shaped3d.axes_of(shp[i], ri)
+        mati = shaped3d.shape_of_row(turn[i])
+        ishaped = shp[i][3] > 0.0
+    ipoly = False
+    if ti.static(shapes & SHAPES_POLY):
+        ipoly = shp[i][3] < 0.0
+    if ti.static(shapes & SHAPES_POLY):
+        if ipoly:
+            fw, mw, dw, work = polyhedra3d.mesh_contacts(
+                i, pos, vel, omega, prop, angle, shp, wall, wpart, row, lawp, wid,
+                whist, wcn, wcf, wcs, flags, dt, laws, ptab, pint)
+    if not ipoly:
+        fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wpart,
+                                         row, lawp, wid, whist, wcn, wcf, wcs, dt,
+                                         laws, ishaped, mati, shi, ranged)
+    if ti.static(prims):
+        # (spheres only: shaped particles are refused with primitives)
+        fp, mp, dp, wp = primitives.prim_contacts(
+            i, vel, omega, prop, xi, prim, ppart, row, lawp, phist, pcn, pcf,
+            pcs, dt, laws, ranged)
+        fw += fp
+        mw += mp
+        dw += dp
+        work += wp
+    return fw, mw, dw, work
+
+
 @cached
 @ti.kernel
 def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
@@ -573,6 +625,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          prop: ti.types.ndarray(), plaw: ti.types.ndarray(), fix: ti.types.ndarray(),
          vfix: ti.types.ndarray(), force: ti.types.ndarray(), torque: ti.types.ndarray(),
          xref: ti.types.ndarray(), pos0: ti.types.ndarray(), facc: ti.types.ndarray(),
+         wacc: ti.types.ndarray(),
          eacc: ti.types.ndarray(),
          estate: ti.types.ndarray(), ework: ti.types.ndarray(),
          nbr: ti.types.ndarray(), ncnt: ti.types.ndarray(), hist: ti.types.ndarray(),
@@ -589,7 +642,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
          pcn: ti.types.ndarray(), pcf: ti.types.ndarray(), pcs: ti.types.ndarray(),
          serial: ti.template(),
          chunk: ti.template(), loads: ti.template(), bonds: ti.template(),
-         ranged: ti.template(), prims: ti.template(), detail: ti.i32, continuum: ti.template(), laws: ti.template(),
+         ranged: ti.template(), prims: ti.template(), periodic: ti.template(), detail: ti.i32, continuum: ti.template(), laws: ti.template(),
          shapes: ti.template(), dim: ti.template()):
     """One step. ``detail`` (1 or 0) also stores what only output reads: per-contact
     normals, scalar forces and overlaps, particle forces, and the kinetic and
@@ -621,6 +674,10 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     the table ``prim``, their contacts' arrays ``phist``, ``pcn``, ``pcf``, ``pcs``,
     their forces ``pforce``, :mod:`tdem.primitives`); every sphere meets each of them.
 
+    ``periodic`` (compile-time): the model has a periodic axis (pairs are then taken at
+    their nearest images and positions wrapped, simp[P_PX0 ...]); without one the
+    checks compile away.
+
     ``dim`` (compile-time): 2 (discs, superellipses, PCMM, segment walls) or 3 (spheres
     and mesh walls); spins and moments are scalars in 2D and 3-vectors in 3D.
 
@@ -637,7 +694,9 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
     alpha_l = simp[P_ALPHA_LOCAL]
     damped = alpha != 0.0 or alpha_l != 0.0
     half_skin2 = (0.5 * simp[P_SKIN]) ** 2
-    per = periodic_axes(simp, dim)
+    per = ti.Vector([0.0] * (2 * dim))      # (no periodic axis: the checks compile away)
+    if ti.static(periodic):
+        per = periodic_axes(simp, dim)
 
     if ti.static(shapes and dim == 2):
         # each angle's cosine and sine once, for all the pairs it takes part in
@@ -667,6 +726,27 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
             csz = n     # (not set: one chunk, the one-thread order)
         if csz < n:
             sp = 10
+    if ti.static(dim == 3):
+        # 3D: the wall contacts first, in a loop of their own (the same chunks), kept
+        # in wacc for the particles that have candidate walls (or primitives) and added
+        # in the pair loop below as if computed there. Few particles touch walls; kept
+        # out of the pair loop, their code does not slow it down
+        ti.loop_config(serialize=serial)
+        for it in range(((n + csz - 1) // csz) << sp):
+            lo = (it >> sp) * csz
+            row = 0
+            if ti.static(chunk):
+                row = it >> sp
+            end = ti.min(n, lo + csz)
+            if it & ((1 << sp) - 1) != 0:
+                end = lo
+            for i in range(lo, end):
+                if ti.static(prims) or wid[i, 0] >= 0:
+                    fw, mw, dw, work = walls_3d(
+                        i, pos, vel, omega, prop, angle, turn, shp, wall, wpart, row, lawp, wid,
+                        whist, wcn, wcf, wcs, flags, dt, laws, ptab, pint, prim, ppart, phist,
+                        pcn, pcf, pcs, ranged, prims, shapes)
+                    wacc[i] = ti.Vector([fw[0], fw[1], fw[2], mw[0], mw[1], mw[2], dw, work])
     ti.loop_config(serialize=serial)
     for it in range(((n + csz - 1) // csz) << sp):
         lo = (it >> sp) * csz
@@ -794,24 +874,13 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                                                  lawp, wid, whist, wcn, wcf, wcs, dt, laws, angle,
                                                  shp, flags, shapes, ranged)
             else:
-                if ti.static(shapes & SHAPES_POLY):
-                    if ipoly:
-                        fw, mw, dw, work = polyhedra3d.mesh_contacts(
-                            i, pos, vel, omega, prop, angle, shp, wall, wpart, row, lawp, wid,
-                            whist, wcn, wcf, wcs, flags, dt, laws, ptab, pint)
-                if not ipoly:
-                    fw, mw, dw, work = mesh_contacts(i, pos, vel, omega, prop, wall, wpart,
-                                                     row, lawp, wid, whist, wcn, wcf, wcs, dt,
-                                                     laws, ishaped, mati, shi, ranged)
-                if ti.static(prims):
-                    # (spheres only: shaped particles are refused with primitives)
-                    fp, mp, dp, wp = primitives.prim_contacts(
-                        i, vel, omega, prop, xi, prim, ppart, row, lawp, phist, pcn, pcf,
-                        pcs, dt, laws, ranged)
-                    fw += fp
-                    mw += mp
-                    dw += dp
-                    work += wp
+                # (computed in the wall loop above)
+                if ti.static(prims) or wid[i, 0] >= 0:
+                    wa = wacc[i]
+                    fw = ti.Vector([wa[0], wa[1], wa[2]])
+                    mw = ti.Vector([wa[3], wa[4], wa[5]])
+                    dw = wa[6]
+                    work = wa[7]
             own = pack(f + fw, tq + mw, dim)
             if ti.static(serial or chunk):
                 facc[i] = facc[i] + own
