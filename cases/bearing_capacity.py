@@ -42,8 +42,10 @@ Set-up (the half of the problem right of the footing's centre line, x ≥ 0)
   of it between (s − s₀)/b = 0.007 and 0.010. s₀ is the surface's relief under the
   footing (the tops of the particles centred on the top edge, highest less lowest): the
   footing carries the soil as a whole only once it has come down onto the lowest of
-  them. It is 0 on the lattices and meshes, and about 0.4 h on a random packing, whose
-  surface particles' tops are as uneven as their radii (0.6–1.4 of the lattices').
+  them. It is 0 on the lattices and meshes, and on the case's random packing, whose
+  discs centred on the sides all have the lattices' radius
+  (``tdem.pack.random(edge_radius=)``: Prandtl's soil has a plane surface); with radii
+  drawn there too (0.6–1.4 of the lattices') it is about 0.4 h.
 
 Why a stiff soil and a small settlement
 ---------------------------------------
@@ -172,10 +174,12 @@ def spec(kind, n, W, H, seed=0):
                 "fit": True}
     if kind == "random":
         # radii 0.6–1.4 of the lattices' (the same mean spacing), denser than jamming
-        # with the holes of the element cover filled, as the other PCMM cases
+        # with the holes of the element cover filled, as the other PCMM cases; the
+        # discs centred on the sides of the lattices' radius, so that the surface is
+        # flush (Prandtl's soil has a plane surface)
         return {"kind": "random", "rmin": 0.3 * h, "rmax": 0.7 * h, "tolerance": 0.5 * h,
                 "fraction": 0.86, "overlap_tol": 0.7, "fill_holes": True,
-                "edge_centres": True, "seed": int(seed)}
+                "edge_centres": True, "edge_radius": 0.5 * h, "seed": int(seed)}
     raise ValueError(f"kind {kind!r}: choose fvm, fvm_cross, regular, cross or random")
 
 
@@ -240,7 +244,7 @@ def footing(kind, n, phi_deg=0.0, speed=SPEED, s_end=S_END, sim_kwargs=None, mix
     seat = 0.0
     if not m.is_fvm:
         # the surface's relief under the footing: the particles centred on the top
-        # edge have tops as uneven as their radii (random packing: 0.4 h), and the
+        # edge have tops as uneven as their radii (a random packing with radii drawn on its sides: 0.4 h), and the
         # footing carries the whole soil only once it has come down onto the lowest of
         # them; the settlement is read from there (lattices: 0)
         edge = x[:, 1] > x[:, 1].max() - tol
