@@ -244,9 +244,10 @@ def footing(kind, n, phi_deg=0.0, speed=SPEED, s_end=S_END, sim_kwargs=None, mix
     seat = 0.0
     if not m.is_fvm:
         # the surface's relief under the footing: the particles centred on the top
-        # edge have tops as uneven as their radii (a random packing with radii drawn on its sides: 0.4 h), and the
-        # footing carries the whole soil only once it has come down onto the lowest of
-        # them; the settlement is read from there (lattices: 0)
+        # edge have tops as uneven as their radii (a random packing with radii drawn
+        # on its sides: 0.4 h), and the footing carries the whole soil only once it
+        # has come down onto the lowest of them; the settlement is read from there
+        # (lattices and the case's flush random packing: 0)
         edge = x[:, 1] > x[:, 1].max() - tol
         under = edge & (x[:, 0] <= b)
         seat = float(top - (x[under, 1] + r[under]).min())
