@@ -130,6 +130,44 @@ def geometry(prim: ti.template(), p, xi):
 
 
 @ti.func
+def wall_law(laws: ti.template(), lawp: ti.template(), L, depth, vn, vt, mass, reff, ri,
+             omega_rel, arm, dt, h, n, ranged: ti.template()):
+    """3D: the contact law of a sphere against a wall (a mesh face,
+    :func:`tdem.step.mesh_contacts`, or a primitive) and the wall's rolling resistance (r̄ = 2 R_i, Jiang Eq. 11b), in
+    contact only (a law with a range zeroes the rolling columns across a gap).
+    ``omega_rel``: the sphere's spin less the wall's; ``arm``: from the centre to the
+    contact point. Returns (force on the sphere, its moment, the rolling couple, the
+    normal force, the tangential force, the law's dissipation, the rolling's
+    dissipation, the history)."""
+    T = ti.static(tangent_dim(3))
+    RW = ti.static(history_width(laws, T))
+    fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(laws, lawp, L, depth, vn, vt, mass, reff,
+                                                 dt, h, n)
+    f = -fn * n + ft
+    mi = moment(arm, f)
+    m_roll = ti.Vector([0.0, 0.0, 0.0])
+    d2 = 0.0
+    if ti.static(h.n >= RW + 7):
+        touching = 1
+        if ti.static(ranged):
+            touching = depth > 0.0
+        if touching:
+            m, m_roll1, th, brk, d2r = rolling_couple_3d(
+                lawp, L, fn_el, kn, cnd, 2.0 * ri, omega_rel, n, dt,
+                get_columns(h, RW, 3), get_columns(h, RW + 3, 3), h[RW + 6])
+            m_roll = m_roll1
+            h = put_columns(h, RW, m)
+            h = put_columns(h, RW + 3, th)
+            h[RW + 6] = brk
+            mi += m_roll
+            d2 = d2r
+        else:
+            for c7 in ti.static(range(7)):
+                h[RW + c7] = 0.0
+    return f, mi, m_roll, fn, ft, d1, d2, h
+
+
+@ti.func
 def prim_contacts(i, vel: ti.template(), omega: ti.template(), prop: ti.template(), xi,
                   prim: ti.template(), ppart: ti.template(), row, lawp: ti.template(),
                   phist: ti.template(), pcn: ti.template(), pcf: ti.template(),
@@ -139,8 +177,6 @@ def prim_contacts(i, vel: ti.template(), omega: ti.template(), prop: ti.template
     dissipation, work of the walls) and adds what each primitive receives (force,
     moment about its point, a contact) to row ``row`` of ``ppart``. With ``ranged`` a
     law with a range acts across a gap below it."""
-    T = ti.static(tangent_dim(3))
-    RW = ti.static(history_width(laws, T))
     ri = prop[i][PROP_RADIUS]
     diss = 0.0
     work = 0.0
@@ -160,30 +196,10 @@ def prim_contacts(i, vel: ti.template(), omega: ti.template(), prop: ti.template
             vw = _col3(prim, p, PR_VX)
             vrel = vw - vel[i] - spin_cross(omega[i], arm)
             vn = vrel.dot(n)
-            fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
-                laws, lawp, L, depth, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri,
-                dt, h, n)
-            f = -fn * n + ft
-            mi = moment(arm, f)
-            m_roll = ti.Vector([0.0, 0.0, 0.0])
-            if ti.static(h.n >= RW + 7):
-                # rolling resistance against the wall (r̄ = 2 R_i), in contact
-                touching = 1
-                if ti.static(ranged):
-                    touching = depth > 0.0
-                if touching:
-                    m, m_roll1, th, brk, d2 = rolling_couple_3d(
-                        lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i], n, dt,
-                        get_columns(h, RW, 3), get_columns(h, RW + 3, 3), h[RW + 6])
-                    m_roll = m_roll1
-                    h = put_columns(h, RW, m)
-                    h = put_columns(h, RW + 3, th)
-                    h[RW + 6] = brk
-                    mi += m_roll
-                    diss += d2
-                else:
-                    for c7 in ti.static(range(7)):
-                        h[RW + c7] = 0.0
+            f, mi, m_roll, fn, ft, d1, d2, h = wall_law(
+                laws, lawp, L, depth, vn, tangent_part(vrel, n), prop[i][PROP_MASS], ri, ri,
+                omega[i], arm, dt, h, n, ranged)
+            diss += d2
             phist[i, p] = h
             pcn[i, p] = n
             pcf[i, p] = ti.Vector([f[0], f[1], f[2], mi[0], mi[1], mi[2]])

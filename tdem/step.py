@@ -495,31 +495,11 @@ def mesh_contacts(i, pos: ti.template(), vel: ti.template(), omega: ti.template(
             vrel = vw - vel[i] - spin_cross(omega[i], arm)
             vn = vrel.dot(n)
             L = ti.cast(wall[w, T_LAW], ti.i32)
-            fn_el, fn, ft, kn, cnd, d1, h = law_force_3d(
+            f, mi, m_roll, fn, ft, d1, d2, h = primitives.wall_law(
                 laws, lawp, L, depth, vn, tangent_part(vrel, n), prop[i][PROP_MASS], radius,
-                dt, h, n)
-            f = -fn * n + ft
-            mi = moment(arm, f)
-            m_roll = ti.Vector([0.0, 0.0, 0.0])
-            if ti.static(h.n >= RW + 7):
-                # rolling resistance against the wall (r̄ = 2 R_i, Jiang Eq. 11b), in contact
-                touching = 1
-                if ti.static(ranged):
-                    touching = depth > 0.0
-                if touching:
-                    m, m_roll1, th, brk, d2 = rolling_couple_3d(
-                        lawp, L, fn_el, kn, cnd, 2.0 * ri, omega[i] - tri_vec(wall, w, T_WX), n,
-                        dt, get_columns(h, RW, 3), get_columns(h, RW + 3, 3), h[RW + 6])
-                    m_roll = m_roll1
-                    h = put_columns(h, RW, m)
-                    h = put_columns(h, RW + 3, th)
-                    h[RW + 6] = brk
-                    mi += m_roll
-                    diss += d2
-                else:
-                    for c7 in ti.static(range(7)):
-                        h[RW + c7] = 0.0
-            elif ti.static(h.n > RW):
+                ri, omega[i] - tri_vec(wall, w, T_WX), arm, dt, h, n, ranged)
+            diss += d2
+            if ti.static(RW < h.n < RW + 7):
                 h[RW] = radius
             whist[i, s] = h
             wcn[i, s] = n
