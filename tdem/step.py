@@ -598,6 +598,21 @@ def walls_3d(i, pos: ti.template(), vel: ti.template(), omega: ti.template(),
     return fw, mw, dw, work
 
 
+@ti.func
+def _chunk_span(it, n, csz, sp, chunk: ti.template()):
+    """Iteration ``it`` of the step's loops over chunks of ``csz`` particles, spread
+    over 2**sp iterations each (only the first does work): its particles [lo, end)
+    and, with ``chunk``, its row of the walls' partial sums (0 without)."""
+    lo = (it >> sp) * csz
+    row = 0
+    if ti.static(chunk):
+        row = it >> sp
+    end = ti.min(n, lo + csz)
+    if it & ((1 << sp) - 1) != 0:
+        end = lo
+    return lo, end, row
+
+
 @cached
 @ti.kernel
 def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarray(),
@@ -713,13 +728,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
         # out of the pair loop, their code does not slow it down
         ti.loop_config(serialize=serial)
         for it in range(((n + csz - 1) // csz) << sp):
-            lo = (it >> sp) * csz
-            row = 0
-            if ti.static(chunk):
-                row = it >> sp
-            end = ti.min(n, lo + csz)
-            if it & ((1 << sp) - 1) != 0:
-                end = lo
+            lo, end, row = _chunk_span(it, n, csz, sp, chunk)
             for i in range(lo, end):
                 if ti.static(prims) or wid[i, 0] >= 0:
                     fw, mw, dw, work = walls_3d(
@@ -729,13 +738,7 @@ def step(pos: ti.types.ndarray(), vel: ti.types.ndarray(), omega: ti.types.ndarr
                     wacc[i] = ti.Vector([fw[0], fw[1], fw[2], mw[0], mw[1], mw[2], dw, work])
     ti.loop_config(serialize=serial)
     for it in range(((n + csz - 1) // csz) << sp):
-        lo = (it >> sp) * csz
-        row = 0         # the chunk's row of the walls' partial sums
-        if ti.static(chunk):
-            row = it >> sp
-        end = ti.min(n, lo + csz)
-        if it & ((1 << sp) - 1) != 0:
-            end = lo
+        lo, end, row = _chunk_span(it, n, csz, sp, chunk)
         for i in range(lo, end):
             f = vec_zero(dim)
             tq = spin_zero(dim)
