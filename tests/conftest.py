@@ -36,3 +36,32 @@ LONG_FILES = ("test_kernel_types.py", "test_voronoi_water.py", "test_biaxial.py"
 def pytest_collection_modifyitems(config, items):
     rank = {name: k for k, name in enumerate(LONG_FILES)}
     items.sort(key=lambda it: rank.get(os.path.basename(str(it.fspath)), len(rank)))
+
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture
+def summation_paths():
+    """Run ``script`` (it saves an array to argv[1] and prints ``chunk N``) once on one
+    thread, twice on two threads with 8 chunks asked, and once with every pair through
+    its slot (TDEM_CHUNKS=0: the GPU's path, on the CPU), each in its own process;
+    returns ({name: the saved array}, {name: the chunk size printed}) for the names
+    "one", "chunks", "chunks again" and "slots"."""
+    import subprocess
+
+    import numpy as np
+
+    def run(script, tmp_path):
+        out, chunk = {}, {}
+        for name, threads, chunks in (("one", "1", ""), ("chunks", "2", "8"),
+                                      ("chunks again", "2", "8"), ("slots", "2", "0")):
+            path = tmp_path / f"{name}.npy"
+            done = subprocess.run([sys.executable, str(script), str(path)],
+                                  env=dict(os.environ, TDEM_THREADS=threads,
+                                           TDEM_SERIAL_BELOW="0", TDEM_CHUNKS=chunks),
+                                  check=True, capture_output=True, text=True)
+            out[name] = np.load(path)
+            chunk[name] = int(done.stdout.split("chunk")[-1])
+        return out, chunk
+    return run

@@ -112,7 +112,7 @@ print("chunk", tdem.backend.chunk_size(sim.n_particles, sim._serial()))
 """
 
 
-def test_one_thread_and_parallel_paths_agree(tmp_path):
+def test_one_thread_and_parallel_paths_agree(tmp_path, summation_paths):
     """On one thread partner forces are summed directly; on two threads, directly
     within each thread's chunk of particles and through the slots across chunks; on
     the GPU's path (TDEM_CHUNKS=0, run here on the CPU) through the slots for every
@@ -120,21 +120,10 @@ def test_one_thread_and_parallel_paths_agree(tmp_path):
     for bit (TDEM_SERIAL_BELOW=0: the 225 discs would otherwise run their loops on one
     thread on all)."""
     import os
-    import subprocess
-    import sys
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     script = tmp_path / "pile.py"
     script.write_text(_PILE.format(root=root))
-    out, chunk = {}, {}
-    for name, threads, chunks in (("one", "1", ""), ("chunks", "2", "8"),
-                                  ("chunks again", "2", "8"), ("slots", "2", "0")):
-        path = tmp_path / f"{name}.npy"
-        run = subprocess.run([sys.executable, str(script), str(path)],
-                             env=dict(os.environ, TDEM_THREADS=threads, TDEM_SERIAL_BELOW="0",
-                                      TDEM_CHUNKS=chunks),
-                             check=True, capture_output=True, text=True)
-        out[name] = np.load(path)
-        chunk[name] = int(run.stdout.split("chunk")[-1])
+    out, chunk = summation_paths(script, tmp_path)
     # 225 discs on two threads: 8 chunks of 29 (asked: a model this small has one)
     assert chunk == {"one": 0, "chunks": 29, "chunks again": 29, "slots": 0}
     # a settling pile is chaotic: compare early enough that round-off has not grown

@@ -333,26 +333,15 @@ print("chunk", tdem.backend.chunk_size(sim.n_particles, sim._serial()))
 """
 
 
-def test_one_thread_and_parallel_paths_agree(tmp_path):
+def test_one_thread_and_parallel_paths_agree(tmp_path, summation_paths):
     """The primitives' forces summed over the chunks of the step's pair loop (two
     threads, 8 chunks) and with every pair through its slot (the GPU's path, run on
     the CPU) agree with one thread to round-off, and repeat bit for bit."""
     import os
-    import subprocess
-    import sys
     here = os.path.dirname(os.path.abspath(__file__))
     script = tmp_path / "piston.py"
     script.write_text(_PISTON.format(root=os.path.dirname(here), tests=here))
-    out, chunk = {}, {}
-    for name, threads, chunks in (("one", "1", ""), ("chunks", "2", "8"),
-                                  ("chunks again", "2", "8"), ("slots", "2", "0")):
-        path = tmp_path / f"{name}.npy"
-        run = subprocess.run([sys.executable, str(script), str(path)],
-                             env=dict(os.environ, TDEM_THREADS=threads, TDEM_SERIAL_BELOW="0",
-                                      TDEM_CHUNKS=chunks),
-                             check=True, capture_output=True, text=True)
-        out[name] = np.load(path)
-        chunk[name] = int(run.stdout.split("chunk")[-1])
+    out, chunk = summation_paths(script, tmp_path)
     assert chunk == {"one": 0, "chunks": 4, "chunks again": 4, "slots": 0}
     scale = np.abs(out["one"]).max(axis=0)
     for name in ("chunks", "slots"):
