@@ -52,7 +52,8 @@ Presets
   0.49 to 0.33 m in 1.3 s), because the particles' volumes change only through
   the elements that exist, and the area of the triangles that are deleted as
   the discs slip into the pores of the packing is lost. 82 min on one thread
-  (2026-12-05, both systems; docs/validation.md); not for tests.
+  (2026-12-05, both systems one after the other), 33 min with ``--parallel`` (one
+  thread each, 2026-12-08; docs/validation.md); not for tests.
 - ``--water cells`` (either preset): the water packed at random as the paper's
   is, as Voronoi cells (``tdem.Fluid(voronoi=True)``, ``physics.pcmm.cells``),
   which hold at rest and keep their area as they flow on any packing. Quick:
