@@ -132,6 +132,7 @@ E_SPHERE, POISSON = 5e6, 0.3
 WIDTH = 6.5                   # slab width in d (the period must hold 3 neighbour cells)
 REST = 1e-5                   # kinetic energy per grain over m g d: "at rest"
 SETTLED = 1e-6                # the settling stops below this
+LANDED_V = 0.02               # m/s: a released grain has landed once it is slower
 FIT_BAND = (0.2, 0.8)         # the flank fit: heights between these shares of the heap's
 BIN = 1.0                     # profile bins (d)
 P_BIN = 2.0                   # pressure bins (d)
@@ -271,6 +272,7 @@ class Heap:
         self.grains = []             # ids of the poured grains
         self.gone = set()            # grains fallen off the base (held)
         self.batch = 0
+        self.landed = {}             # grain id: its x when it first came to rest (m)
 
     # -------------------------------------------------------------- bookkeeping
     def state(self):
@@ -290,6 +292,31 @@ class Heap:
         if low:
             self.sim.fix_particles(low, vx=0.0, vy=0.0, vz=0.0, omega=(0.0, 0.0, 0.0))
             self.gone.update(low)
+
+    def note_landed(self):
+        """Keep the x of every grain that has come to rest (speed below LANDED_V) for
+        the first time since it was released: how far the heap's grains move out after
+        they land is how much the heap spreads as it is built."""
+        new = [i for i in self.grains if i not in self.landed and i not in self.gone]
+        if not new:
+            return
+        p = self.sim.particles.numpy()
+        ids = np.array(new, dtype=int)
+        slow = np.linalg.norm(p["velocity"][ids], axis=1) < LANDED_V
+        for i, x in zip(ids[slow], p["position"][ids[slow], 0]):
+            self.landed[int(i)] = float(x)
+
+    def spread(self):
+        """How far the grains on the base moved outward (away from the axis) since they
+        landed, in d: the mean and the share that moved out by more than d/2."""
+        ids = [i for i in self.free_ids() if int(i) in self.landed]
+        if not ids:
+            return {"mean_d": None, "share_half_d": None, "grains": 0}
+        x = self.sim.particles.numpy()["position"][np.array(ids), 0]
+        x0 = np.array([self.landed[int(i)] for i in ids])
+        out = np.sign(x0) * (x - x0) / D
+        return {"mean_d": float(out.mean()), "share_half_d": float(np.mean(out > 0.5)),
+                "grains": len(ids)}
 
     def surface_height(self, x, halfwidth):
         """The highest particle top within ``halfwidth`` of each x (the base's top
@@ -347,6 +374,7 @@ class Heap:
             self.add(pts, velocity=(0.0, 0.0, -self.cfg["release_v"]))
             self.sim.run(until=self.sim.time + self.cfg["batch_dt"])
             self.hold_fallen()
+            self.note_landed()
 
     def pour_layers(self, n, angle):
         """Horizontal layers over the whole base, each narrower than the one below by
@@ -381,6 +409,7 @@ class Heap:
             self.add(pts)
             self.sim.run(until=self.sim.time + self.cfg["layer_dt"])
             self.hold_fallen()
+            self.note_landed()
             k += 1
 
     def settle(self, max_time, chunk=0.1):
@@ -390,6 +419,7 @@ class Heap:
         while self.sim.time - t0 < max_time:
             self.sim.run(until=self.sim.time + chunk)
             self.hold_fallen()
+            self.note_landed()
             ratio = self.kinetic_ratio()
             if ratio < SETTLED:
                 break
@@ -572,6 +602,7 @@ def run_heap(model, sequence, cfg, opts, seed, angle=None, log=common.say):
         heap.pour_layers(cfg["particles"], angle)
     t_settle, ratio = heap.settle(cfg["settle_max"])
     m = heap.measures()
+    spread = heap.spread()
     centres, heights = profile(m["x"], m["tops"], BIN * D, base=heap.base_top)
     fit = fit_flanks(centres, heights)
     px, pp = pressure_profile(m["base_x"], m["base_fz"], m["floor_fz"], heap.half,
@@ -586,14 +617,37 @@ def run_heap(model, sequence, cfg, opts, seed, angle=None, log=common.say):
            "pressure_x": px, "pressure": pp, "packing": packing,
            "time_s": heap.sim.time, "settle_s": t_settle, "steps": heap.sim.steps,
            "dt_s": heap.sim.dt, "wall_s": time.perf_counter() - w0,
-           "layer_angle": angle, "base_top": heap.base_top, **m,
+           "layer_angle": angle, "base_top": heap.base_top, "spread": spread, **m,
            "balance": (float(m["base_fz"].sum()) + m["floor_fz"]) / m["weight"]}
     log(f"{model.name:7s} {sequence:7s} seed {seed}: {m['grains']} grains "
         f"({m['fallen']} fell off), angle {fmt_angle(angles)}, height "
         f"{fit['height'] / D:.1f} d, base/weight {res['balance']:.4f}, "
-        f"kinetic {m['kinetic_ratio']:.1e} mgd, {heap.sim.steps} steps, "
+        f"kinetic {m['kinetic_ratio']:.1e} mgd, moved out after landing "
+        f"{spread['mean_d'] if spread['mean_d'] is not None else float('nan'):.2f} d, "
+        f"{heap.sim.steps} steps, "
         f"{res['wall_s']:.0f} s")
     return res, heap
+
+
+def spread_words(heaps, sequence):
+    """Words for a pressure note: how far the heaps' grains moved outward after they
+    landed (:meth:`Heap.spread`), over the seeds; for layered heaps also the angle the
+    layers were set back at against the angle the heap ended at. A heap whose grains
+    spread outward as it is built arches over its centre (the dip of a wedge pour); a
+    heap built in layers that stay where they land carries each column's own weight."""
+    sp = [r["spread"] for r in heaps if r.get("spread", {}).get("mean_d") is not None]
+    if not sp:
+        return ""
+    words = (f"; after landing its grains moved outward by "
+             f"{np.mean([q['mean_d'] for q in sp]):.2f} d on average, "
+             f"{100 * np.mean([q['share_half_d'] for q in sp]):.0f} % of them by more than "
+             "d/2 (mean over the seeds)")
+    if sequence == "layered":
+        set_back = [r["layer_angle"] for r in heaps if r.get("layer_angle") is not None]
+        if set_back:
+            words += (f"; the layers were set back at {np.mean(set_back):.1f}°, the heap "
+                      f"ended at {np.mean([r['angle'] for r in heaps]):.1f}°")
+    return words
 
 
 def fmt_angle(angles):
@@ -760,6 +814,7 @@ def finish(args, out, cfg, runs, clock):
     shapes = {seq: pressure_shape(q["x"], q["mean"], q["se"], heap_half)
               for seq, q in press.items()}
     want = {"wedge": "dip", "layered": "maximum"}
+    heaps_of = {"wedge": cubes, "layered": layered}
     pressure_checks = []
     for seq, s in shapes.items():
         note = (f"{NO_NUMBERS}; the thesis: a {want[seq]} under the apex. Apex "
@@ -767,7 +822,7 @@ def finish(args, out, cfg, runs, clock):
                 f"{s.get('off_axis_max_Pa', 0):.0f} Pa at |x| = "
                 f"{s.get('off_axis_max_at_m', 0) / D:.0f} d, difference "
                 f"{s.get('difference_Pa', 0):.0f} ± {s.get('difference_se_Pa', 0):.0f} Pa "
-                f"(s.e. over the seeds)")
+                f"(s.e. over the seeds)") + spread_words(heaps_of[seq], seq)
         if s["resolved"]:
             pressure_checks.append(common.check(
                 f"{seq}.pressure_under_apex", s["shape"], want[seq], common.EQUAL, "",
@@ -842,7 +897,8 @@ def finish(args, out, cfg, runs, clock):
                                      "fallen", "packing", "balance", "kinetic_ratio",
                                      "overlap_mean", "overlap_max", "contacts", "time_s",
                                      "settle_s", "steps", "dt_s", "wall_s", "layer_angle")}
-                  | {"height_m": r["fit"]["height"], "apex_x_m": r["fit"]["apex_x"]}
+                  | {"height_m": r["fit"]["height"], "apex_x_m": r["fit"]["apex_x"],
+                     "moved_out_after_landing": r.get("spread")}
                   for r in allr],
     }
     plot_profiles(runs, out / "heap_profiles.png")
