@@ -844,6 +844,9 @@ def _figures(results, rate_note=""):
 
 
 def _extra(p):
+    p.add_argument("--rescore", default=None, metavar="DIR",
+                   help="make the checks of the finished sweep in DIR again from its "
+                        "summary.json and rewrite it (no run)")
     p.add_argument("--delta", type=float, default=None,
                    help="run one test with this shape parameter (0: no rolling resistance; "
                         "default 0.4 with --model)")
@@ -908,6 +911,94 @@ def phi_table(tests):
     return "\n".join(rows) + "\n"
 
 
+def sweep_checks(results):
+    """The sweep's checks against the paper. Tests at several strain rates are compared
+    rate by rate (the check names end in ``_rate<r>``, the rate at 200 kPa): pooling
+    them would mix a rate-dependent angle into one number. An envelope's slope needs
+    tests at two confining stresses or more; with one, only the mean of the tests is
+    compared (with several specimens, their mean)."""
+    by_rate = {}
+    for r in results:
+        by_rate.setdefault(round(rate_at_200kpa(r["task"]), 9), []).append(r)
+    checks = []
+    for rate, rs in sorted(by_rate.items(), reverse=True):
+        tag = f"_rate{rate:g}" if len(by_rate) > 1 else ""
+        at = f" (tests at {rate:g} /s at 200 kPa)" if len(by_rate) > 1 else ""
+        env = envelopes(rs)
+        for (model, delta), (pk, rk) in TARGETS.items():
+            name = material_name(model, delta)
+            if name not in env:
+                continue
+            stresses = sorted({c for c in env[name]["confining"]})
+            where = ("the three confining stresses" if len(stresses) > 2 else
+                     " and ".join(f"{c / 1e3:g}" for c in stresses) + " kPa")
+            if len(stresses) > 1:
+                checks += [
+                    _phi_check(f"envelope_phi_peak_{name}{tag}", env[name]["peak"]["phi"], pk,
+                               "slope of the peak envelope, apparent cohesion "
+                               f"{env[name]['peak']['cohesion'] / 1e3:.1f} kPa" + at),
+                    _phi_check(f"envelope_phi_residual_{name}{tag}",
+                               env[name]["residual"]["phi"], rk,
+                               "slope of the residual envelope" + at),
+                ]
+            checks += [
+                _phi_check(f"mean_phi_peak_{name}{tag}",
+                           float(np.mean(env[name]["phi_peak_tests"])), pk,
+                           f"mean of the tests at {where}" + at
+                           + ("" if len(stresses) > 1 else
+                              "; one confining stress: no envelope slope")),
+                _phi_check(f"mean_phi_residual_{name}{tag}",
+                           float(np.mean(env[name]["phi_residual_tests"])), rk,
+                           f"mean of the tests at {where}" + at),
+            ]
+        names = ("none", "model2_delta0.4", "model1_delta0.4")
+        if all(n in env for n in names):
+            none, m2, m1 = (float(np.mean(env[n]["phi_peak_tests"])) for n in names)
+            checks.append(common.check(
+                f"model2_between_none_and_model1{tag}", bool(none < m2 < m1), True,
+                common.EQUAL, "",
+                f"mean peak phi at delta = 0.4: none {none:.2f}, Model 2 {m2:.2f}, "
+                f"Model 1 {m1:.2f} (the paper: 24.4, 26.5, 29.0; also 28.8 for Model 1 in "
+                "its §5.2)" + at))
+        m1 = {r["task"]["delta"] for r in rs if r["task"]["model"] == 1
+              or r["task"]["delta"] == 0.0}
+        if len(m1) > 1:
+            increases = bool(np.all(np.diff(
+                [np.mean([r["phi"]["phi_peak"] for r in rs if r["task"]["delta"] == d
+                          and r["task"]["model"] in (0, 1)]) for d in sorted(m1)]) > 0))
+            checks.append(common.check(
+                f"model1_phi_peak_increases_with_delta{tag}", increases, True, common.EQUAL,
+                "", "mean peak φ of Model 1 over the confining stresses rises with δ (paper "
+                "Fig. 13)" + at))
+    return checks
+
+
+def rescore(folder):
+    """The checks of a finished sweep made again from its ``summary.json`` (its tests'
+    tasks and angles), by today's :func:`sweep_checks`; the summary is rewritten in
+    place with its measured time, threads and date kept. Returns the summary."""
+    import json
+    from pathlib import Path
+    path = Path(folder) / "summary.json"
+    old = json.loads(path.read_text())
+    if old.get("data", {}).get("mode") != "sweep":
+        from tdem.errors import InputError
+        raise InputError(f"rescore: {path} is not a biaxial sweep's summary")
+    results = [{"task": t["task"], "phi": t["phi"],
+                "name": material_name(t["task"]["model"], t["task"]["delta"])}
+               for t in old["data"]["tests"]]
+    data = dict(old["data"], envelopes=envelopes(results))
+    summary = common.summary(CASE, old["preset"], sweep_checks(results), data,
+                             old["wall_time_s"], threads=old.get("threads"),
+                             paper=old.get("paper"), notes=old.get("notes"),
+                             variant=old.get("variant"))
+    for k in ("date", "cpu_count", "tdem_version"):
+        if k in old:
+            summary[k] = old[k]
+    common.write_summary(Path(folder), summary)
+    return summary
+
+
 def _main_sweep(args, out, cfg, clock):
     from tdem.errors import InputError
     if args.workers < 1:
@@ -941,38 +1032,7 @@ def _main_sweep(args, out, cfg, clock):
             [{"task": r["task"], "phi": r["phi"]} for r in results])
         + ("\n" + spread_table(results) if len({r["task"]["seed"] for r in results}) > 1
            or len({round(rate_at_200kpa(r["task"]), 9) for r in results}) > 1 else ""))
-    checks = []
-    for (model, delta), (pk, rs) in TARGETS.items():
-        name = material_name(model, delta)
-        if name in env:
-            checks += [
-                _phi_check(f"envelope_phi_peak_{name}", env[name]["peak"]["phi"], pk,
-                           "slope of the peak envelope, apparent cohesion "
-                           f"{env[name]['peak']['cohesion'] / 1e3:.1f} kPa"),
-                _phi_check(f"envelope_phi_residual_{name}", env[name]["residual"]["phi"], rs,
-                           "slope of the residual envelope"),
-                _phi_check(f"mean_phi_peak_{name}", float(np.mean(env[name]["phi_peak_tests"])),
-                           pk, "mean of the tests at the three confining stresses"),
-                _phi_check(f"mean_phi_residual_{name}",
-                           float(np.mean(env[name]["phi_residual_tests"])), rs,
-                           "mean of the tests at the three confining stresses"),
-            ]
-    names = ("none", "model2_delta0.4", "model1_delta0.4")
-    if all(n in env for n in names):
-        none, m2, m1 = (float(np.mean(env[n]["phi_peak_tests"])) for n in names)
-        checks.append(common.check(
-            "model2_between_none_and_model1", bool(none < m2 < m1), True, common.EQUAL, "",
-            f"mean peak phi at delta = 0.4: none {none:.2f}, Model 2 {m2:.2f}, "
-            f"Model 1 {m1:.2f} (the paper: 24.4, 26.5, 29.0; also 28.8 for Model 1 in "
-            "its §5.2)"))
-    m1 = {r["task"]["delta"]: r for r in results if r["task"]["model"] == 1
-          or r["task"]["delta"] == 0.0}
-    increases = bool(np.all(np.diff(
-        [np.mean([r["phi"]["phi_peak"] for r in results if r["task"]["delta"] == d
-                  and r["task"]["model"] in (0, 1)]) for d in sorted(m1)]) > 0))
-    checks.append(common.check(
-        "model1_phi_peak_increases_with_delta", increases, True, common.EQUAL, "",
-        "mean peak φ of Model 1 over the confining stresses rises with δ (paper Fig. 13)"))
+    checks = sweep_checks(results)
     data = {
         "mode": "sweep",
         "envelopes": env,
@@ -992,6 +1052,9 @@ def _main_sweep(args, out, cfg, clock):
 def main(argv=None):
     args, out = common.parse(CASE, argv, description=__doc__.splitlines()[0], extra=_extra)
     from tdem.errors import InputError
+    if args.rescore:
+        common.print_checks(rescore(args.rescore))
+        return 0
     clock = common.Stopwatch()
     cfg = PRESETS[args.preset]
     if not (args.confining > 0 and math.isfinite(args.confining)):

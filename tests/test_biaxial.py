@@ -355,6 +355,48 @@ def test_spread_table_means_deviations_and_envelope_slopes():
     assert "| none | 0.1 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) |" in text
 
 
+def _test_result(seed, s, pk, rs, rate=0.1):
+    """A no-rolling test at confining stress ``s`` whose peak and residual stresses
+    give exactly these angles."""
+    out = {"task": {"model": 0, "delta": 0.0, "confining": s, "seed": seed,
+                    "strain_rate": rate * math.sqrt(s / 200e3)}, "name": "none", "phi": {}}
+    for key, phi in (("peak", pk), ("residual", rs)):
+        k = math.sin(math.radians(phi))
+        sv = s * (1 + k) / (1 - k)
+        out["phi"].update({f"phi_{key}": phi})
+        if key == "peak":
+            out["phi"].update(sigma_v_peak=sv, sigma_h_at_peak=s)
+        else:
+            out["phi"].update(sigma_v_residual=sv, sigma_h_residual=s)
+    return out
+
+
+def test_sweep_checks_compare_rate_by_rate_and_slopes_only_over_several_stresses(tmp_path):
+    """A sweep over rates at one confining stress (the rate study): each rate compared
+    on its own (pooled, a fit through tests at one stress read 90° before), and no
+    envelope slope from one stress; over three stresses the slope is fitted (22° here,
+    through the origin). rescore() makes a kept sweep's checks again from its summary."""
+    res = [_test_result(s, 200e3, pk, pk - 4.0, rate)
+           for rate, pk in ((1.0, 26.0), (0.1, 20.0)) for s in (0, 1)]
+    checks = {c["name"]: c for c in biaxial.sweep_checks(res)}
+    assert set(checks) == {"mean_phi_peak_none_rate1", "mean_phi_residual_none_rate1",
+                           "mean_phi_peak_none_rate0.1", "mean_phi_residual_none_rate0.1"}
+    assert checks["mean_phi_peak_none_rate1"]["value"] == pytest.approx(26.0)
+    assert checks["mean_phi_peak_none_rate0.1"]["value"] == pytest.approx(20.0)
+    assert "no envelope slope" in checks["mean_phi_peak_none_rate0.1"]["note"]
+    three = [_test_result(0, s, 22.0, 18.0) for s in (100e3, 200e3, 400e3)]
+    checks = {c["name"]: c for c in biaxial.sweep_checks(three)}
+    assert checks["envelope_phi_peak_none"]["value"] == pytest.approx(22.0, abs=1e-9)
+    assert checks["envelope_phi_peak_none"]["pass"] is False        # the paper: 24.4 ± 2
+    # rescore: a kept summary's checks made again from its tests
+    from cases import _common as common
+    kept = common.summary("biaxial", "paper", [], {"mode": "sweep", "tests": [
+        {"task": r["task"], "phi": r["phi"]} for r in res]}, 12.0, threads=1)
+    common.write_summary(tmp_path, kept)
+    again = biaxial.rescore(tmp_path)
+    assert again["counts"]["checks"] == 4 and again["wall_time_s"] == 12.0
+
+
 def test_materials_of_a_sweep_are_parsed_and_checked():
     assert biaxial.parse_material("1:0.4") == (1, 0.4)
     assert biaxial.parse_material("0:0") == (0, 0.0)
