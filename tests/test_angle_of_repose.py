@@ -166,6 +166,19 @@ def test_small_heaps_rest_on_the_base_and_carry_their_weight(heap):
     assert 0.45 < r["packing"] < 0.8, name
 
 
+def test_a_wedge_heap_grows_by_its_grains_moving_out_after_they_land(heap):
+    """A wedge pour grows by avalanches: its grains land near the axis and move outward
+    (Heap.spread, which the pressure notes report for both pours). Every grain on the
+    base has a landing place, and on average they moved outward (these 150-grain
+    heaps: cubes 0.15 d, 11 % of them by more than d/2, spheres 0.27 d and 22 %; the
+    paper preset's 900-grain heaps of cubes 2.2-2.5 d)."""
+    name, r = heap
+    sp = r["spread"]
+    assert sp["grains"] == r["grains"], name
+    assert sp["mean_d"] > 0.05, (name, sp)
+    assert sp["share_half_d"] > 0.05, (name, sp)
+
+
 def test_small_heaps_have_an_angle_on_both_flanks(heap):
     """Each flank is fitted, at an angle between 5° and 60°, unless it is a steep edge
     too short for the fit's three bins within 20–80 % of the heap's height: a
