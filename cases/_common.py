@@ -30,7 +30,7 @@ COMMAND = None
 # quick-times:start
 QUICK_WALL_S = {
     "nine_disc": 10, "photoelastic": 23, "biaxial": 80, "elastic_gravity": 10,
-    "uniaxial_compression": 18, "wave_bar": 38, "soil_cutting": 22,
+    "uniaxial_compression": 18, "wave_bar": 38, "soil_cutting": 19,
     "contact_burst": 160, "water_blocks": 81, "plate_loading": 76,
     "ellipsoid_compression": 114, "impact_benchmarks": 24, "angle_of_repose": 720,
     "dam_break": 31, "bearing_capacity": 39, "rotating_drum": 62, "hopper_discharge": 74,
