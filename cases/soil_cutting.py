@@ -125,7 +125,10 @@ by 4.5 cm by the end; the paper preset of 2026-12-07: 2-5 cm, then a slump from 
 more), with no cut soil lying on the floor near it, and no elements left joining the
 soil above the cut to the soil below within 0.3 m of the face after 0.9 s while it
 went on moving. The cause was the heel ploughing 2 cm below the edge (above): with
-the bevelled end the quick preset's face moves 0.4 cm by the end. P4's bulk stress is also read 0.05, 0.2 and 0.3 m from
+the bevelled end the quick preset's face moves 0.4 cm by the end. In a paper-preset
+run with the bevelled blade, stopped at 20 s paper-equivalent, the face no longer
+slumps but creeps steadily (1.1 cm at 10 s, 2.6 cm at 20 s; docs/cases.md): what
+makes that is not yet measured. P4's bulk stress is also read 0.05, 0.2 and 0.3 m from
 both fixed sides (``data.P4_bulk_stress_end_Pa_by_distance_m``): the paper does
 not give P4's position, and near the fixed corner the stress changes fast with it.
 
