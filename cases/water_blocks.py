@@ -316,20 +316,11 @@ def gap_to_blocks(x, squares):
     """Distance (m) from each point of ``x`` (n, 2) to the nearest block outline, the
     blocks given by their corners ``squares`` (a list of (4, 2) arrays in order round
     the square); 0 inside a block."""
+    from tdem.pack import _signed_distance
     x = np.asarray(x, dtype=float).reshape(-1, 2)
     best = np.full(len(x), np.inf)
-    for sq in squares:
-        a, b = sq, np.roll(sq, -1, axis=0)
-        d = b - a                                                   # (4, 2) edges
-        t = np.clip(np.einsum("nke,ke->nk", x[:, None, :] - a[None], d)
-                    / np.einsum("ke,ke->k", d, d)[None], 0.0, 1.0)
-        near = a[None] + t[..., None] * d[None]
-        dist = np.linalg.norm(x[:, None, :] - near, axis=2).min(axis=1)
-        # inside: on the same side of every edge (the corners go round one way)
-        cross = (d[None, :, 0] * (x[:, None, 1] - a[None, :, 1])
-                 - d[None, :, 1] * (x[:, None, 0] - a[None, :, 0]))
-        inside = np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)
-        best = np.minimum(best, np.where(inside, 0.0, dist))
+    for sq in squares:       # the signed distance is positive inside
+        best = np.minimum(best, np.maximum(-_signed_distance(x, np.asarray(sq, float))[0], 0.0))
     return best
 
 

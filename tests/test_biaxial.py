@@ -330,31 +330,6 @@ def test_sweep_over_seeds_and_rates():
         biaxial.main(["--seeds", "1", "2"])
 
 
-def test_spread_table_means_deviations_and_envelope_slopes():
-    """sweep.md over several specimens: φ as mean ± standard deviation (range, count)
-    over the seeds; each seed's envelope slope fitted to its own tests."""
-    def r(seed, s, pk, rs, rate=0.1):
-        # a test whose peak and residual stresses give exactly these angles
-        out = {"task": {"model": 0, "delta": 0.0, "confining": s, "seed": seed,
-                        "strain_rate": rate * math.sqrt(s / 200e3)}, "name": "none", "phi": {}}
-        for key, phi in (("peak", pk), ("residual", rs)):
-            k = math.sin(math.radians(phi))
-            sv = s * (1 + k) / (1 - k)
-            out["phi"].update({f"phi_{key}": phi})
-            if key == "peak":
-                out["phi"].update(sigma_v_peak=sv, sigma_h_at_peak=s)
-            else:
-                out["phi"].update(sigma_v_residual=sv, sigma_h_residual=s)
-        return out
-    res = [r(0, 100e3, 22.0, 18.0), r(0, 400e3, 22.0, 18.0),
-           r(1, 100e3, 24.0, 20.0), r(1, 400e3, 24.0, 20.0)]
-    text = biaxial.spread_table(res)
-    assert "| none | 0.1 | 100 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) | " \
-           "24.4° / 19.3° |" in text
-    # each seed's envelope passes through the origin at its own angle: slopes 22 and 24
-    assert "| none | 0.1 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) |" in text
-
-
 def _test_result(seed, s, pk, rs, rate=0.1):
     """A no-rolling test at confining stress ``s`` whose peak and residual stresses
     give exactly these angles."""
@@ -369,6 +344,19 @@ def _test_result(seed, s, pk, rs, rate=0.1):
         else:
             out["phi"].update(sigma_v_residual=sv, sigma_h_residual=s)
     return out
+
+
+def test_spread_table_means_deviations_and_envelope_slopes():
+    """sweep.md over several specimens: φ as mean ± standard deviation (range, count)
+    over the seeds; each seed's envelope slope fitted to its own tests."""
+    r = _test_result
+    res = [r(0, 100e3, 22.0, 18.0), r(0, 400e3, 22.0, 18.0),
+           r(1, 100e3, 24.0, 20.0), r(1, 400e3, 24.0, 20.0)]
+    text = biaxial.spread_table(res)
+    assert "| none | 0.1 | 100 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) | " \
+           "24.4° / 19.3° |" in text
+    # each seed's envelope passes through the origin at its own angle: slopes 22 and 24
+    assert "| none | 0.1 | 23.0° ± 1.4 (22.0–24.0, 2) | 19.0° ± 1.4 (18.0–20.0, 2) |" in text
 
 
 def test_sweep_checks_compare_rate_by_rate_and_slopes_only_over_several_stresses(tmp_path):

@@ -156,3 +156,14 @@ def test_the_density_table_reports_each_run():
     assert len(lines) == 3
     assert lines[2] == ("| 5600 kg/m³ | four columns | slid | 0.123 m | 1.0° | 0.56 s | no | "
                         "4 of 4 |")
+
+
+def test_gap_to_blocks_is_the_distance_to_the_nearest_outline():
+    """The fastest water's gap to a block (water_vmax's note): 0 inside a block, the
+    distance to the nearest edge or corner outside, over every block."""
+    import numpy as np
+    from cases.water_blocks import gap_to_blocks
+    squares = [np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]]),
+               np.array([[3, 0], [4, 0], [4, 1], [3, 1.0]])]
+    pts = np.array([[0.5, 0.5], [2.0, 0.5], [2.0, 2.0], [-1.0, 0.5], [4.5, 0.5]])
+    assert gap_to_blocks(pts, squares) == pytest.approx([0.0, 1.0, 2 ** 0.5, 1.0, 0.5])
